@@ -1,0 +1,69 @@
+"""Two arithmetic back-ends for closed-form formulas: float64 arrays and mpmath scalars.
+
+A closed form is written once against the small namespace below (``sin``,
+``cos``, ``sqrt``, ``sinc``, ``atan2``) and evaluated either vectorised in
+float64 (:data:`NUMPY`) or in arbitrary precision (:func:`mp_backend`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import mpmath
+import numpy as np
+
+from strapdown.rotation._series import sinc as _np_sinc
+
+
+@dataclass(frozen=True)
+class Backend:
+    """Elementary functions of one arithmetic."""
+
+    name: str
+    sin: Any
+    cos: Any
+    sqrt: Any
+    atan2: Any
+    sinc: Any  # sin(x)/x, 1 at 0
+    num: Any  # converts a Python/NumPy number to this arithmetic
+    zero: Any
+    one: Any
+
+
+NUMPY = Backend(
+    name="float64",
+    sin=np.sin,
+    cos=np.cos,
+    sqrt=np.sqrt,
+    atan2=np.arctan2,
+    sinc=_np_sinc,
+    num=np.float64,
+    zero=np.float64(0.0),
+    one=np.float64(1.0),
+)
+
+
+def _mp_sinc(x):
+    return mpmath.mpf(1) if x == 0 else mpmath.sin(x) / x
+
+
+def _mp_num(x):
+    if isinstance(x, mpmath.mpf):
+        return x
+    if isinstance(x, str):
+        return mpmath.mpf(x)
+    return mpmath.mpf(float(x)) if isinstance(x, np.floating) else mpmath.mpf(x)
+
+
+MPMATH = Backend(
+    name="mpmath",
+    sin=mpmath.sin,
+    cos=mpmath.cos,
+    sqrt=mpmath.sqrt,
+    atan2=mpmath.atan2,
+    sinc=_mp_sinc,
+    num=_mp_num,
+    zero=mpmath.mpf(0),
+    one=mpmath.mpf(1),
+)

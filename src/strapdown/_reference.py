@@ -1,0 +1,77 @@
+"""Plain-Python reference implementations, generic over the arithmetic.
+
+The same code runs on Python floats (the oracle the compiled kernels are
+tested against) and on mpmath numbers (arbitrary-precision analysis). It
+mirrors :mod:`strapdown._kernels` operation by operation, except that the
+exponential map uses ``sin(|φ|/2)/|φ|`` directly (exact in mpmath).
+"""
+
+from __future__ import annotations
+
+from strapdown._backend import Backend
+
+
+def rotvec(theta, base, m, k, zero):
+    """φ = Σθ + Σ_{i<j} k[i][j] θ_i × θ_j over theta[base : base + m]."""
+    px = py = pz = zero
+    for i in range(m):
+        px += theta[base + i][0]
+        py += theta[base + i][1]
+        pz += theta[base + i][2]
+    for i in range(m - 1):
+        ax, ay, az = theta[base + i]
+        for j in range(i + 1, m):
+            c = k[i][j]
+            if c != 0:
+                bx, by, bz = theta[base + j]
+                px += c * (ay * bz - az * by)
+                py += c * (az * bx - ax * bz)
+                pz += c * (ax * by - ay * bx)
+    return px, py, pz
+
+
+def quat_mul(p, q):
+    pw, px, py, pz = p
+    qw, qx, qy, qz = q
+    return (
+        pw * qw - px * qx - py * qy - pz * qz,
+        pw * qx + px * qw + py * qz - pz * qy,
+        pw * qy - px * qz + py * qw + pz * qx,
+        pw * qz + px * qy - py * qx + pz * qw,
+    )
+
+
+def quat_exp(phi, m: Backend):
+    ang = m.sqrt(phi[0] * phi[0] + phi[1] * phi[1] + phi[2] * phi[2])
+    if ang == 0:
+        return (m.one, m.zero, m.zero, m.zero)
+    s = m.sin(ang / 2) / ang
+    return (m.cos(ang / 2), s * phi[0], s * phi[1], s * phi[2])
+
+
+def update(qp, phi, m: Backend):
+    w, x, y, z = quat_mul(qp, quat_exp(phi, m))
+    inv = 1 / m.sqrt(w * w + x * x + y * y + z * z)
+    return (w * inv, x * inv, y * inv, z * inv)
+
+
+def conventional(theta, k, q0, m: Backend):
+    """Conventional structure (see :func:`strapdown._kernels.conventional_kernel`)."""
+    n = len(k)
+    out = [tuple(q0)]
+    for u in range(len(theta) // n):
+        out.append(update(out[-1], rotvec(theta, u * n, n, k, m.zero), m))
+    return out
+
+
+def realtime(theta, ks, q0, m: Backend):
+    """Real-time structure (see :func:`strapdown._kernels.realtime_kernel`)."""
+    nsub = len(ks)
+    out = [tuple(q0)]
+    for j in range(1, len(theta) + 1):
+        if j < nsub:
+            out.append(update(out[0], rotvec(theta, 0, j, ks[j - 1], m.zero), m))
+        else:
+            phi = rotvec(theta, j - nsub, nsub, ks[nsub - 1], m.zero)
+            out.append(update(out[j - nsub], phi, m))
+    return out

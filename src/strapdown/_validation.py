@@ -1,0 +1,100 @@
+"""Input validation shared by every public function.
+
+Each checker returns a float64 array and raises :class:`ValueError` whose
+message names the argument and the problem (shape, NaN, sign, ordering).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = [
+    "as_dcms",
+    "as_quaternions",
+    "as_times",
+    "as_vectors",
+    "finite_array",
+    "positive",
+    "positive_int",
+]
+
+
+def finite_array(x, name: str) -> np.ndarray:
+    """Return ``x`` as float64, raising if it holds NaN or infinity."""
+    try:
+        a = np.asarray(x, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{name} must be numeric, got {type(x).__name__}") from exc
+    if not np.all(np.isfinite(a)):
+        bad = np.argwhere(~np.isfinite(a))
+        where = tuple(int(i) for i in bad[0])
+        raise ValueError(f"{name} contains NaN or infinity (first at index {where})")
+    return a
+
+
+def _trailing(x, name: str, trailing: tuple[int, ...], label: str) -> np.ndarray:
+    a = finite_array(x, name)
+    k = len(trailing)
+    if a.ndim < k or a.shape[a.ndim - k :] != trailing:
+        expected = "(..., " + ", ".join(str(d) for d in trailing) + ")"
+        raise ValueError(f"{name} must be {label} of shape {expected}, got shape {a.shape}")
+    return a
+
+
+def as_vectors(x, name: str = "vector") -> np.ndarray:
+    """3-vectors, shape ``(..., 3)``."""
+    return _trailing(x, name, (3,), "3-vectors")
+
+
+def as_quaternions(x, name: str = "quaternion", *, unit: bool = False) -> np.ndarray:
+    """Scalar-first quaternions, shape ``(..., 4)``; non-zero norm required."""
+    q = _trailing(x, name, (4,), "scalar-first quaternions")
+    n = np.linalg.norm(q, axis=-1)
+    if np.any(n == 0.0):
+        raise ValueError(f"{name} contains a zero quaternion")
+    if unit and np.any(np.abs(n - 1.0) > 1e-6):
+        raise ValueError(f"{name} must be unit quaternions (|q| differs from 1 by > 1e-6)")
+    return q
+
+
+def as_dcms(x, name: str = "dcm") -> np.ndarray:
+    """Direction cosine matrices, shape ``(..., 3, 3)``."""
+    return _trailing(x, name, (3, 3), "direction cosine matrices")
+
+
+def as_times(t, name: str = "t", *, min_len: int = 1) -> np.ndarray:
+    """Strictly increasing 1-D time stamps."""
+    a = finite_array(t, name)
+    if a.ndim != 1:
+        raise ValueError(f"{name} must be 1-D time stamps of shape (n,), got shape {a.shape}")
+    if a.size < min_len:
+        raise ValueError(f"{name} needs at least {min_len} samples, got {a.size}")
+    if a.size > 1:
+        d = np.diff(a)
+        if np.any(d <= 0):
+            i = int(np.argmax(d <= 0))
+            raise ValueError(
+                f"{name} must be strictly increasing: {name}[{i + 1}] = {a[i + 1]!r} "
+                f"does not exceed {name}[{i}] = {a[i]!r}"
+            )
+    return a
+
+
+def positive(x, name: str) -> float:
+    """A finite, strictly positive scalar."""
+    try:
+        v = float(x)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{name} must be a positive number, got {x!r}") from exc
+    if not np.isfinite(v) or v <= 0.0:
+        raise ValueError(f"{name} must be a finite positive number, got {x!r}")
+    return v
+
+
+def positive_int(x, name: str) -> int:
+    """A strictly positive integer (bools rejected)."""
+    if isinstance(x, bool) or not isinstance(x, int | np.integer):
+        raise ValueError(f"{name} must be a positive integer, got {x!r}")
+    if x <= 0:
+        raise ValueError(f"{name} must be a positive integer, got {x!r}")
+    return int(x)

@@ -1,0 +1,196 @@
+"""One configuration end to end: motion → gyro → algorithm → analysis.
+
+:func:`evaluate` is what ``strapdown evaluate`` runs. It returns an
+:class:`Evaluation` whose :meth:`Evaluation.to_dict` gives the documented
+JSON keys.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from strapdown import analysis, sensors
+from strapdown._validation import positive, positive_int
+from strapdown.coning import MAX_SUBSAMPLES, CoefficientSet, coefficient_set
+from strapdown.motions import ClassicalConing, Motion, PureSpin, SpinConing
+from strapdown.precision import run_mp
+from strapdown.structures import STRUCTURES, run_structure
+
+__all__ = ["MOTIONS", "Evaluation", "EvaluationConfig", "build_motion", "evaluate"]
+
+MOTIONS = ("coning", "spin", "spin-coning")
+ALGORITHMS = ("rotvec",)
+
+
+@dataclass(frozen=True)
+class EvaluationConfig:
+    """Everything that defines one evaluation (SI units; degrees only where named).
+
+    ``samples`` is ``round(duration · sample_rate)``, reduced to a multiple of
+    N for the conventional structure so every increment is used.
+    """
+
+    motion: str = "coning"
+    half_angle_deg: float = 1.0
+    cone_rate_hz: float = 1.0
+    spin_rate_dps: float = 0.0
+    sample_rate_hz: float = 10_000.0
+    duration: float = 2.0
+    algorithm: str = "rotvec"
+    subsamples: int = 3
+    coefficients: str = "table3"
+    structure: str = "conventional"
+    precision: int | None = None
+    gyro: sensors.GyroErrors | None = field(default=None)
+    seed: int | None = None
+
+    def validate(self) -> None:
+        if self.motion not in MOTIONS:
+            raise ValueError(f"unknown motion {self.motion!r}; choose one of {', '.join(MOTIONS)}")
+        if self.algorithm not in ALGORITHMS:
+            raise ValueError(
+                f"unknown algorithm {self.algorithm!r}; choose one of {', '.join(ALGORITHMS)}"
+            )
+        if self.structure not in STRUCTURES:
+            raise ValueError(
+                f"unknown structure {self.structure!r}; choose one of {', '.join(STRUCTURES)}"
+            )
+        positive(self.sample_rate_hz, "sample rate (Hz)")
+        positive(self.duration, "duration (s)")
+        n = positive_int(self.subsamples, "subsamples N")
+        if n > MAX_SUBSAMPLES:
+            raise ValueError(f"subsamples N must be at most {MAX_SUBSAMPLES}, got {n}")
+        if self.motion != "spin":
+            if not math.isfinite(self.cone_rate_hz) or self.cone_rate_hz == 0:
+                raise ValueError(f"cone rate must be finite and non-zero, got {self.cone_rate_hz}")
+            if not math.isfinite(self.half_angle_deg):
+                raise ValueError(f"half angle must be finite, got {self.half_angle_deg}")
+        if not math.isfinite(self.spin_rate_dps):
+            raise ValueError(f"spin rate must be finite, got {self.spin_rate_dps}")
+        if self.precision is not None:
+            positive_int(self.precision, "precision (digits)")
+            if self.gyro is not None and not self.gyro.is_ideal:
+                raise ValueError("arbitrary precision runs take ideal increments only")
+
+    @property
+    def h(self) -> float:
+        return 1.0 / self.sample_rate_hz
+
+    @property
+    def samples(self) -> int:
+        n = round(self.duration * self.sample_rate_hz)
+        if self.structure == "conventional":
+            n -= n % self.subsamples
+        if n < self.subsamples:
+            raise ValueError(
+                f"duration {self.duration} s at {self.sample_rate_hz} Hz gives {n} samples, "
+                f"fewer than N = {self.subsamples}"
+            )
+        return n
+
+
+def build_motion(cfg: EvaluationConfig) -> Motion:
+    """The reference motion a configuration names."""
+    a = math.radians(cfg.half_angle_deg)
+    om = 2.0 * math.pi * cfg.cone_rate_hz
+    ws = math.radians(cfg.spin_rate_dps)
+    if cfg.motion == "coning":
+        return ClassicalConing(a, om)
+    if cfg.motion == "spin":
+        if ws == 0:
+            raise ValueError("pure spin needs a non-zero --spin-rate-dps")
+        return PureSpin(ws)
+    return SpinConing(a, om, ws)
+
+
+@dataclass(frozen=True)
+class Evaluation:
+    """Result of :func:`evaluate` (rad, s)."""
+
+    config: EvaluationConfig
+    t: np.ndarray
+    err: np.ndarray
+    angle: np.ndarray
+    chain: np.ndarray
+    drift: analysis.DriftEstimate
+    chain_drifts: tuple[analysis.DriftEstimate, ...]
+    cone_axis: np.ndarray | None
+    predicted: float | None
+    update_period: float
+    samples: int
+
+    @property
+    def cone_axis_drift(self) -> float | None:
+        if self.cone_axis is None:
+            return None
+        return float(self.drift.rate @ self.cone_axis)
+
+    def to_dict(self) -> dict:
+        """The documented JSON record."""
+        c = self.config
+        return {
+            "motion": c.motion,
+            "algorithm": c.algorithm,
+            "structure": c.structure,
+            "subsamples": c.subsamples,
+            "coefficients": c.coefficients,
+            "precision_digits": c.precision,
+            "drift_rate_rad_s": [float(x) for x in self.drift.rate],
+            "cone_axis_drift_rad_s": self.cone_axis_drift,
+            "predicted_drift_rad_s": self.predicted,
+            "drift_method": self.drift.method,
+            "drift_points": self.drift.points,
+            "chain_cone_axis_drift_rad_s": (
+                None if self.cone_axis is None
+                else [float(d.rate @ self.cone_axis) for d in self.chain_drifts]
+            ),
+            "max_error_rad": float(self.angle.max()),
+            "rms_error_rad": float(np.sqrt(np.mean(self.angle**2))),
+            "update_period_s": self.update_period,
+            "samples": self.samples,
+        }
+
+
+def evaluate(cfg: EvaluationConfig, *, coefficients: CoefficientSet | None = None) -> Evaluation:
+    """Run one configuration and analyse it.
+
+    Parameters
+    ----------
+    cfg : EvaluationConfig
+    coefficients : CoefficientSet, optional
+        Overrides ``cfg.coefficients`` (e.g. a user matrix).
+    """
+    cfg.validate()
+    motion = build_motion(cfg)
+    cs = coefficients or coefficient_set(cfg.coefficients, cfg.subsamples)
+    if cs.n != cfg.subsamples:
+        raise ValueError(f"coefficient set has N = {cs.n}, configuration says {cfg.subsamples}")
+    h, n = cfg.h, cfg.samples
+    if cfg.precision is not None:
+        s = run_mp(motion, cs, structure=cfg.structure, h=h, samples=n, digits=cfg.precision)
+        t, err, ang, chain = s.t, s.err, s.angle, s.chain
+    else:
+        rec = sensors.increments(motion, h, n, errors=cfg.gyro, rng=cfg.seed)
+        sol = run_structure(cfg.structure, rec.data, cs, h=h, q0=motion.attitude(0.0))
+        err, ang = analysis.attitude_errors(sol.t, sol.q, motion)
+        t, chain = sol.t, sol.chain
+    chains = analysis.chain_drift_rate(t, err, chain, period=motion.period)
+    if len(chains) == 1:
+        drift = chains[0]
+    else:
+        drift = analysis.DriftEstimate(
+            np.mean([d.rate for d in chains], axis=0),
+            chains[0].method + f" (mean of {len(chains)} chains)",
+            sum(d.points for d in chains),
+        )
+    predicted = None
+    if cfg.motion == "coning" and cs.classical_optimum:
+        predicted = analysis.table1_prediction(motion.half_angle, motion.cone_rate, h, cs.n)
+    return Evaluation(
+        config=cfg, t=t, err=err, angle=ang, chain=chain, drift=drift, chain_drifts=chains,
+        cone_axis=motion.cone_axis, predicted=predicted,
+        update_period=analysis.update_period(cfg.structure, cs.n, h), samples=n,
+    )

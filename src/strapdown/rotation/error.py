@@ -1,0 +1,28 @@
+"""Attitude error of an estimate against truth (conventions.md "Errors and metrics")."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from strapdown.rotation.quaternion import quat_conjugate, quat_multiply, rotvec_from_quat
+
+__all__ = ["attitude_error_angle", "attitude_error_quat", "attitude_error_vector"]
+
+
+def attitude_error_quat(q_est, q_true) -> np.ndarray:
+    """``δq = q_est ⊗ q_true*`` (reference-frame error quaternion)."""
+    return quat_multiply(q_est, quat_conjugate(q_true))
+
+
+def attitude_error_vector(q_est, q_true) -> np.ndarray:
+    """Reference-frame error rotation vector ``δφ_n = log(q_est ⊗ q_true*)``, rad.
+
+    Invariant under ``q → −q`` of either argument.
+    """
+    return rotvec_from_quat(attitude_error_quat(q_est, q_true))
+
+
+def attitude_error_angle(q_est, q_true) -> np.ndarray:
+    """Error angle ``2 atan2(|vec δq|, |w δq|)`` in ``[0, π]``, rad."""
+    dq = attitude_error_quat(q_est, q_true)
+    return 2.0 * np.arctan2(np.linalg.norm(dq[..., 1:], axis=-1), np.abs(dq[..., 0]))

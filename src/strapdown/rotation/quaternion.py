@@ -1,0 +1,130 @@
+"""Quaternions: Hamilton product, scalar first ``[w, x, y, z]``.
+
+All functions broadcast over leading dimensions ``(..., 4)``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from strapdown._validation import as_quaternions, as_vectors
+from strapdown.rotation._series import SMALL_ANGLE, sinc
+
+__all__ = [
+    "quat_canonical",
+    "quat_conjugate",
+    "quat_from_rotvec",
+    "quat_identity",
+    "quat_multiply",
+    "quat_normalize",
+    "quat_rotate",
+    "rotvec_from_quat",
+]
+
+
+def quat_identity(shape: tuple[int, ...] = ()) -> np.ndarray:
+    """Identity quaternions of the given batch shape, ``shape + (4,)``."""
+    q = np.zeros((*shape, 4))
+    q[..., 0] = 1.0
+    return q
+
+
+def quat_multiply(p, q) -> np.ndarray:
+    """Hamilton product ``p ⊗ q`` (broadcast over leading dimensions)."""
+    p = as_quaternions(p, "p")
+    q = as_quaternions(q, "q")
+    pw, px, py, pz = np.moveaxis(p, -1, 0)
+    qw, qx, qy, qz = np.moveaxis(q, -1, 0)
+    return np.stack(
+        [
+            pw * qw - px * qx - py * qy - pz * qz,
+            pw * qx + px * qw + py * qz - pz * qy,
+            pw * qy - px * qz + py * qw + pz * qx,
+            pw * qz + px * qy - py * qx + pz * qw,
+        ],
+        axis=-1,
+    )
+
+
+def quat_conjugate(q) -> np.ndarray:
+    """Conjugate ``q*`` (the inverse of a unit quaternion)."""
+    q = as_quaternions(q, "q")
+    return q * np.array([1.0, -1.0, -1.0, -1.0])
+
+
+def quat_normalize(q) -> np.ndarray:
+    """Unit quaternion with the same attitude."""
+    q = as_quaternions(q, "q")
+    return q / np.linalg.norm(q, axis=-1, keepdims=True)
+
+
+def quat_canonical(q) -> np.ndarray:
+    """Representative with ``w >= 0`` (ties broken on the first non-zero component).
+
+    ``q`` and ``-q`` are the same attitude; this picks one so that arrays can be
+    compared element-wise.
+    """
+    q = as_quaternions(q, "q")
+    sign = np.ones(q.shape[:-1])
+    undecided = np.ones(q.shape[:-1], dtype=bool)
+    for i in range(4):
+        c = q[..., i]
+        decide = undecided & (c != 0.0)
+        sign = np.where(decide & (c < 0.0), -1.0, sign)
+        undecided &= ~decide
+    return q * sign[..., None]
+
+
+def quat_rotate(q, v) -> np.ndarray:
+    """Rotate body vectors into the reference frame: ``v_n = q ⊗ [0, v_b] ⊗ q*``.
+
+    ``q`` need not be unit; it is normalised first.
+    """
+    q = quat_normalize(q)
+    v = as_vectors(v, "v")
+    w = q[..., :1]
+    u = q[..., 1:]
+    t = 2.0 * np.cross(u, v)
+    return v + w * t + np.cross(u, t)
+
+
+def quat_from_rotvec(rotvec) -> np.ndarray:
+    """Exponential map ``q(φ) = [cos(|φ|/2), sin(|φ|/2) φ/|φ|]``.
+
+    Exact for every angle; ``sin(|φ|/2)/|φ|`` uses its series below
+    :data:`~strapdown.rotation.SMALL_ANGLE` (Li & Zhang 2017 eq. 9 in
+    quaternion form; conventions.md "Rotation vector").
+    """
+    phi = as_vectors(rotvec, "rotvec")
+    angle = np.linalg.norm(phi, axis=-1)
+    half = 0.5 * angle
+    w = np.cos(half)
+    s = 0.5 * sinc(half)  # sin(|φ|/2) / |φ|
+    return np.concatenate([w[..., None], s[..., None] * phi], axis=-1)
+
+
+def rotvec_from_quat(q) -> np.ndarray:
+    """Logarithm map: the rotation vector with ``|φ| ∈ [0, π]``.
+
+    Uses ``|φ| = 2 atan2(|v|, |w|)`` with the sign of ``w`` folded into the
+    vector part, which is accurate near 0 and near π and insensitive to the
+    norm of ``q``.
+    """
+    q = as_quaternions(q, "q")
+    w = q[..., 0]
+    v = q[..., 1:]
+    sign = np.where(w < 0.0, -1.0, 1.0)
+    w = w * sign
+    v = v * sign[..., None]
+    s = np.linalg.norm(v, axis=-1)
+    angle = 2.0 * np.arctan2(s, w)
+    # scale = angle / s, with the series 2/w (1 - r²/3 + r⁴/5) in r = s/w for small s/w.
+    small = s < SMALL_ANGLE * w
+    ws = np.where(w == 0.0, 1.0, w)
+    r2 = (s / ws) ** 2
+    series = 2.0 / ws * (1.0 - r2 / 3.0 + r2 * r2 / 5.0)
+    ss = np.where(s == 0.0, 1.0, s)
+    scale = np.where(small, series, angle / ss)
+    return scale[..., None] * v
+
+
