@@ -242,8 +242,9 @@ def reproduce(out: str | Path, *, progress: Callable[[str], None] | None = None)
                                                              n, PAPER_H))
             p = printed[n - 1]
             ok = math.isclose(ours, p, rel_tol=1e-9)
+            fits = p / (n * PAPER_H)
             rows4.append([rate, n, _g(ours), p, "reproduced" if ok else
-                          f"differs: printed = {p / ours:.3g} × ω·T (fits {p / (n * PAPER_H):.0f} °/s)"])
+                          f"differs: printed = {p / ours:.3g} × ω·T (fits {fits:.0f} °/s)"])
         for n in NS:
             ours = math.degrees(analysis.rotation_per_update(math.radians(rate), "realtime", n,
                                                              PAPER_H))
