@@ -1,0 +1,110 @@
+"""Command line: JSON contract, human output, clear errors, reproduction output."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import pytest
+
+from strapdown.cli import main
+
+KEYS = {"drift_rate_rad_s", "cone_axis_drift_rad_s", "predicted_drift_rad_s", "max_error_rad",
+        "rms_error_rad", "update_period_s", "samples"}
+
+
+def run(capsys, *args):
+    code = main(list(args))
+    return code, capsys.readouterr()
+
+
+def test_evaluate_json_contract(capsys):
+    code, out = run(capsys, "evaluate", "--subsamples", "2", "--sample-rate-hz", "60",
+                    "--duration", "10", "--json")
+    assert code == 0
+    d = json.loads(out.out)
+    assert KEYS <= set(d)
+    assert len(d["drift_rate_rad_s"]) == 3
+    assert d["samples"] == 600
+    assert d["update_period_s"] == pytest.approx(2 / 60)
+    assert d["cone_axis_drift_rad_s"] / d["predicted_drift_rad_s"] == pytest.approx(1, abs=0.01)
+
+
+def test_evaluate_realtime_and_precision(capsys):
+    code, out = run(capsys, "evaluate", "--subsamples", "3", "--sample-rate-hz", "60",
+                    "--duration", "2", "--half-angle-deg", str(math.degrees(1e-6)),
+                    "--structure", "realtime", "--precision", "40", "--json")
+    d = json.loads(out.out)
+    assert code == 0 and d["precision_digits"] == 40
+    assert d["update_period_s"] == pytest.approx(1 / 60)
+    assert d["cone_axis_drift_rad_s"] / d["predicted_drift_rad_s"] == pytest.approx(1, abs=0.02)
+
+
+def test_evaluate_spin_has_null_cone_keys(capsys):
+    _, out = run(capsys, "evaluate", "--motion", "spin", "--spin-rate-dps", "3600",
+                 "--duration", "0.5", "--json")
+    d = json.loads(out.out)
+    assert d["cone_axis_drift_rad_s"] is None and d["predicted_drift_rad_s"] is None
+
+
+def test_evaluate_human_readable(capsys):
+    code, out = run(capsys, "evaluate", "--duration", "1")
+    assert code == 0
+    assert "drift rate" in out.out and "Table 1 law" in out.out and "measured/law" in out.out
+
+
+@pytest.mark.parametrize(
+    ("args", "msg"),
+    [
+        (["--subsamples", "0"], "subsamples N must be a positive integer"),
+        (["--subsamples", "9"], "at most 6"),
+        (["--sample-rate-hz", "-5"], "sample rate"),
+        (["--duration", "0"], "duration"),
+        (["--half-angle-deg", "nan"], "half angle must be finite"),
+        (["--cone-rate-hz", "0"], "cone rate"),
+        (["--duration", "0.0001", "--subsamples", "3"], "fewer than N = 3"),
+        (["--coefficients", "miller", "--subsamples", "2"], "N = 3 only"),
+        (["--precision", "10"], "at least 17"),
+        (["--motion", "spin"], "spin-rate-dps"),
+    ],
+)
+def test_evaluate_bad_input_exits_2_with_message(capsys, args, msg):
+    with pytest.raises(SystemExit) as exc:
+        main(["evaluate", *args])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert msg in err and "Traceback" not in err
+
+
+def test_unknown_flag_is_rejected(capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["evaluate", "--subsample", "3"])  # abbreviations are not accepted
+    assert exc.value.code == 2
+
+
+def test_reproduce_refuses_file_as_out(tmp_path, capsys):
+    f = tmp_path / "x"
+    f.write_text("keep me")
+    with pytest.raises(SystemExit) as exc:
+        main(["reproduce", "li2017", "--out", str(f)])
+    assert exc.value.code == 2
+    assert f.read_text() == "keep me"
+
+
+@pytest.mark.slow
+def test_reproduce_li2017_writes_report(tmp_path, capsys):
+    code, _ = run(capsys, "reproduce", "li2017", "--out", str(tmp_path))
+    assert code == 0
+    report = (tmp_path / "report.md").read_text()
+    for name in ("table1", "table2", "table3", "table4", "table5", "float64_vs_mp",
+                 "drift_vs_omega_h"):
+        assert (tmp_path / f"{name}.csv").is_file() and (tmp_path / f"{name}.md").is_file()
+    for png in ("drift_vs_omega_h.png", "update_period.png", "realtime_sawtooth.png"):
+        assert (tmp_path / png).stat().st_size > 10_000
+        assert png in report
+    assert "Table 2 does not reproduce" in report
+    t1 = (tmp_path / "table1.csv").read_text().splitlines()
+    assert sum("reproduced" in line for line in t1[1:]) == 5
+    t4 = (tmp_path / "table4.csv").read_text()
+    assert t4.count("differs") == 10  # the 3600 and 7200 °/s rows
+    assert not list(tmp_path.glob(".*"))  # no temporary files left behind
