@@ -46,14 +46,12 @@ def as_vectors(x, name: str = "vector") -> np.ndarray:
     return _trailing(x, name, (3,), "3-vectors")
 
 
-def as_quaternions(x, name: str = "quaternion", *, unit: bool = False) -> np.ndarray:
+def as_quaternions(x, name: str = "quaternion") -> np.ndarray:
     """Scalar-first quaternions, shape ``(..., 4)``; non-zero norm required."""
     q = _trailing(x, name, (4,), "scalar-first quaternions")
     n = np.linalg.norm(q, axis=-1)
     if np.any(n == 0.0):
         raise ValueError(f"{name} contains a zero quaternion")
-    if unit and np.any(np.abs(n - 1.0) > 1e-6):
-        raise ValueError(f"{name} must be unit quaternions (|q| differs from 1 by > 1e-6)")
     return q
 
 

@@ -13,7 +13,14 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from strapdown._validation import as_quaternions, as_times, as_vectors, positive, positive_int
+from strapdown._validation import (
+    as_quaternions,
+    as_times,
+    as_vectors,
+    finite_array,
+    positive,
+    positive_int,
+)
 from strapdown.coning import table1_drift_constant
 from strapdown.motions import Motion
 from strapdown.rotation.error import attitude_error_angle, attitude_error_vector
@@ -135,10 +142,12 @@ def chain_drift_rate(t, err, chain, *, period: float | None = None) -> tuple[Dri
     """
     t = as_times(t, "t", min_len=2)
     chain = np.asarray(chain)
+    if chain.shape != t.shape:
+        raise ValueError(f"chain must have shape {t.shape} to match t, got {chain.shape}")
+    h = float(np.median(np.diff(t)))
     out = []
     for c in np.unique(chain):
         idx = np.flatnonzero(chain == c)
-        h = float(np.median(np.diff(t)))
         out.append(drift_rate(t[idx], np.asarray(err)[idx], period=period,
                               reference_time=t[idx[0]], h=h))
     return tuple(out)
@@ -152,6 +161,7 @@ def table1_prediction(half_angle: float, cone_rate: float, h: float, n: int) -> 
     is negative: the computed attitude drifts against the cone rotation.
     """
     h = positive(h, "h")
+    half_angle, cone_rate = finite_array([half_angle, cone_rate], "half_angle/cone_rate")
     c = float(table1_drift_constant(n))
     return -c * half_angle**2 * cone_rate * (cone_rate * h) ** (2 * n)
 
@@ -172,7 +182,7 @@ def rotation_per_update(rate: float, structure: str, n: int, h: float) -> float:
 
     This is what Li & Zhang 2017 Tables 4/5 call the "angular increment per update".
     """
-    return abs(float(rate)) * update_period(structure, n, h)
+    return abs(float(finite_array(rate, "rate"))) * update_period(structure, n, h)
 
 
 def integrate_attitude_ode(motion: Motion, t, *, q0=None, rtol: float = 1e-13,

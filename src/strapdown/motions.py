@@ -138,8 +138,24 @@ class _ClosedForm(Motion):
         return self._increment(MPMATH, (t0 + t1) / 2, t1 - t0)
 
 
+class _ConingAboutX(_ClosedForm):
+    """Closed-form motions that cone about the reference x axis at ``cone_rate``."""
+
+    half_angle: float
+    cone_rate: float
+
+    def _check_cone(self) -> None:
+        finite_array(self.half_angle, "half_angle")
+        if float(self.cone_rate) == 0.0 or not np.isfinite(self.cone_rate):
+            raise ValueError(f"cone_rate must be finite and non-zero, got {self.cone_rate!r}")
+
+    @property
+    def cone_axis(self) -> np.ndarray:  # type: ignore[override]
+        return np.array([1.0, 0.0, 0.0])
+
+
 @dataclass(frozen=True)
-class ClassicalConing(_ClosedForm):
+class ClassicalConing(_ConingAboutX):
     """Classical coning (Li & Zhang 2017 eq. 7; Bortz 1971).
 
     ``q_n_b(t) = [cos(a/2), 0, sin(a/2) cos Ωt, sin(a/2) sin Ωt]``, body rate
@@ -158,13 +174,7 @@ class ClassicalConing(_ClosedForm):
     cone_rate: float
 
     def __post_init__(self):
-        finite_array(self.half_angle, "half_angle")
-        if float(self.cone_rate) == 0.0 or not np.isfinite(self.cone_rate):
-            raise ValueError(f"cone_rate must be finite and non-zero, got {self.cone_rate!r}")
-
-    @property
-    def cone_axis(self) -> np.ndarray:  # type: ignore[override]
-        return np.array([1.0, 0.0, 0.0])
+        self._check_cone()
 
     @property
     def period(self) -> float:  # type: ignore[override]
@@ -226,7 +236,7 @@ class PureSpin(_ClosedForm):
 
 
 @dataclass(frozen=True)
-class SpinConing(_ClosedForm):
+class SpinConing(_ConingAboutX):
     """Spin and coning coexisting: ``q_n_b(t) = q_cone(t) ⊗ q_x(ω_s t)``.
 
     ``q_cone`` is :class:`ClassicalConing` (half angle ``a``, cone rate ``Ω``)
@@ -247,13 +257,8 @@ class SpinConing(_ClosedForm):
     spin_rate: float
 
     def __post_init__(self):
-        finite_array([self.half_angle, self.spin_rate], "half_angle/spin_rate")
-        if float(self.cone_rate) == 0.0 or not np.isfinite(self.cone_rate):
-            raise ValueError(f"cone_rate must be finite and non-zero, got {self.cone_rate!r}")
-
-    @property
-    def cone_axis(self) -> np.ndarray:  # type: ignore[override]
-        return np.array([1.0, 0.0, 0.0])
+        self._check_cone()
+        finite_array(self.spin_rate, "spin_rate")
 
     @property
     def period(self) -> float | None:  # type: ignore[override]

@@ -205,7 +205,11 @@ def realtime(
 
 
 def run_structure(name: str, increments, coefficients, *, h, t0=0.0, q0=None) -> AttitudeSolution:
-    """Dispatch by structure name (``"conventional"`` or ``"realtime"``)."""
+    """Dispatch by structure name (``"conventional"`` or ``"realtime"``).
+
+    The conventional structure drops a tail of fewer than N increments here
+    (``tail="drop"``); call :func:`conventional` directly to have it refused.
+    """
     if name == "conventional":
         return conventional(increments, coefficients, h=h, t0=t0, q0=q0, tail="drop")
     if name == "realtime":
