@@ -100,3 +100,16 @@ def realtime_kernel(theta, ks, q0, q_out):
         else:
             _rotvec(theta, j - nsub, nsub, ks[nsub - 1], phi)
             _update(q_out[j - nsub], phi, q_out[j])
+
+
+@njit(cache=True)
+def chain_kernel(phi, q0, stride, q_out):
+    """Chain rotation vectors: ``q[k] = q[k − stride] ⊗ q(φ_k)`` for k ≥ stride.
+
+    phi (n, 3) holds φ_1 … φ_n; q0 (stride, 4) the first ``stride`` attitudes;
+    q_out (n + stride, 4) with q_out[:stride] = q0. Stride 1 is a single chain.
+    """
+    for s in range(stride):
+        q_out[s, :] = q0[s]
+    for k in range(phi.shape[0]):
+        _update(q_out[k], phi[k], q_out[k + stride])

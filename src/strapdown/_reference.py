@@ -75,3 +75,28 @@ def realtime(theta, ks, q0, m: Backend):
             phi = rotvec(theta, j - nsub, nsub, ks[nsub - 1], m.zero)
             out.append(update(out[j - nsub], phi, m))
     return out
+
+
+def chain(phi, q0, stride, m: Backend):
+    """Reference twin of :func:`strapdown._kernels.chain_kernel` (q0: list of ``stride`` quats)."""
+    out = [tuple(q) for q in q0]
+    for k, p in enumerate(phi):
+        out.append(update(out[k], p, m))
+    return out
+
+
+def windowed_rotvec(samples, weights, pairs, zero):
+    """φ = Σ_n w_n s_n + Σ (i, j, k) k · s_i × s_j for one window of samples."""
+    px = py = pz = zero
+    for w, (sx, sy, sz) in zip(weights, samples, strict=True):
+        if w != 0:
+            px += w * sx
+            py += w * sy
+            pz += w * sz
+    for i, j, c in pairs:
+        ax, ay, az = samples[i]
+        bx, by, bz = samples[j]
+        px += c * (ay * bz - az * by)
+        py += c * (az * bx - ax * bz)
+        pz += c * (ax * by - ay * bx)
+    return px, py, pz

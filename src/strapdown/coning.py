@@ -39,6 +39,7 @@ __all__ = [
     "MAX_SUBSAMPLES",
     "TABLE3",
     "CoefficientSet",
+    "WindowedAlgorithm",
     "coefficient_set",
     "coefficient_set_names",
     "rotation_vectors",
@@ -237,3 +238,56 @@ def rotation_vectors(increments, coefficients: CoefficientSet) -> np.ndarray:
             if k[i, j] != 0.0:
                 phi = phi + k[i, j] * np.cross(g[:, i], g[:, j])
     return phi
+
+
+@dataclass(frozen=True)
+class WindowedAlgorithm:
+    """A rotation-vector algorithm over a window of samples (general form).
+
+    ``φ = s_α Σ_n w_n x_{b+o_n} + s_β Σ_p c_p x_{b+o_i} × x_{b+o_j}`` for the
+    update starting at sample ``b``, with ``s_α = 1, s_β = 1`` for increment
+    input and ``s_α = h, s_β = h²`` for rate input. Updates every ``update``
+    samples.
+
+    Attributes
+    ----------
+    input : {"increment", "rate"}
+    update : int
+    offsets : tuple of int
+        Node offsets from the update's first sample (negative: history).
+    weights, pair_coefficients : tuple of Fraction
+        Exact weights per node and coefficient per pair.
+    pairs : tuple of (int, int)
+        Node indices of each cross product.
+    name : str
+    """
+
+    input: str
+    update: int
+    offsets: tuple[int, ...]
+    weights: tuple
+    pairs: tuple[tuple[int, int], ...]
+    pair_coefficients: tuple
+    name: str = "windowed"
+
+    @property
+    def history(self) -> int:
+        """Samples needed before the first update's start."""
+        return max(0, -min(self.offsets))
+
+    @property
+    def span(self) -> int:
+        """Largest node offset (the update needs samples up to b + span)."""
+        return max(self.offsets)
+
+    def rotation_vectors(self, samples: np.ndarray, starts: np.ndarray, h: float) -> np.ndarray:
+        """φ for the updates starting at sample indices ``starts`` (vectorised)."""
+        idx = starts[:, None] + np.asarray(self.offsets)[None, :]
+        s = samples[idx]  # (updates, nodes, 3)
+        sa, sb = (1.0, 1.0) if self.input == "increment" else (h, h * h)
+        w = np.array([float(x) for x in self.weights])
+        phi = sa * np.einsum("n,unk->uk", w, s)
+        for (i, j), c in zip(self.pairs, self.pair_coefficients, strict=True):
+            if c != 0:
+                phi += (sb * float(c)) * np.cross(s[:, i], s[:, j])
+        return phi

@@ -98,6 +98,12 @@ class Motion(abc.ABC):
             f"{type(self).__name__} has no closed form for arbitrary-precision evaluation"
         )
 
+    def rate_mp(self, t) -> tuple:
+        """Body rate at ``t`` as three mpmath numbers."""
+        raise NotImplementedError(
+            f"{type(self).__name__} has no closed form for arbitrary-precision evaluation"
+        )
+
 
 class _ClosedForm(Motion):
     """A motion whose attitude and increments are written once for both back-ends."""
@@ -131,6 +137,9 @@ class _ClosedForm(Motion):
 
     def attitude_mp(self, t) -> tuple:
         return self._attitude(MPMATH, MPMATH.num(t))
+
+    def rate_mp(self, t) -> tuple:
+        return self._rate(MPMATH, MPMATH.num(t))
 
     def increment_mp(self, t0, t1) -> tuple:
         t0 = MPMATH.num(t0)

@@ -23,11 +23,11 @@ import numpy as np
 from strapdown import _reference
 from strapdown._backend import MPMATH
 from strapdown._validation import positive, positive_int
-from strapdown.coning import CoefficientSet
+from strapdown.coning import CoefficientSet, WindowedAlgorithm
 from strapdown.motions import Motion
 from strapdown.structures import STRUCTURES, startup_sets
 
-__all__ = ["MAX_MP_SAMPLES", "MpSolution", "run_mp"]
+__all__ = ["MAX_MP_SAMPLES", "MpSolution", "run_mp", "run_windowed_mp"]
 
 #: Largest number of increments one arbitrary-precision run accepts.
 MAX_MP_SAMPLES = 2_000_000
@@ -58,10 +58,103 @@ class MpSolution:
     digits: int
 
 
+def _single_chain_phis(theta, coefficients: CoefficientSet):
+    """Single-chain rotation vectors in mpmath, with the same start-up as the float64 path."""
+    from strapdown.structures import single_chain_coefficients
+
+    if coefficients.name not in ("table3", "none"):
+        raise ValueError("the single chain takes 'table3' (designed optimum) or 'none'")
+    n = coefficients.n if coefficients.name == "table3" else 1
+    sets = {m: [_mpf(c) for c in single_chain_coefficients(m)] for m in range(1, n + 1)}
+    zero = mpmath.mpf(0)
+    phis = []
+    for k in range(len(theta)):
+        cs = sets[min(k + 1, n)]
+        window = [theta[k - m] for m in range(len(cs), -1, -1)]  # θ_{k−M} … θ_k
+        last = len(window) - 1
+        pairs = [(last - m, last, c) for m, c in enumerate(cs, start=1)]
+        w = [zero] * last + [mpmath.mpf(1)]
+        phis.append(_reference.windowed_rotvec(window, w, pairs, zero))
+    return phis
+
+
 def _mp_matrix(cs: CoefficientSet):
     if cs.exact is not None:
         return [[mpmath.mpf(v.numerator) / v.denominator for v in row] for row in cs.exact]
     return [[mpmath.mpf(float(v)) for v in row] for row in cs.matrix]
+
+
+def _mpf(v):
+    from fractions import Fraction
+
+    if isinstance(v, Fraction):
+        return mpmath.mpf(v.numerator) / v.denominator
+    return mpmath.mpf(float(v))
+
+
+def _errors(motion, q, t_out, chain, digits):
+    err = np.empty((len(q), 3))
+    ang = np.empty(len(q))
+    for i, (qe, tt) in enumerate(zip(q, t_out, strict=True)):
+        qt = motion.attitude_mp(tt)
+        v, a = _log(_reference.quat_mul(qe, (qt[0], -qt[1], -qt[2], -qt[3])))
+        err[i] = [float(c) for c in v]
+        ang[i] = float(a)
+    return MpSolution(np.array([float(x) for x in t_out]), err, ang, chain, digits)
+
+
+def _check_run(motion, h, samples, digits):
+    if not motion.has_closed_form:
+        raise ValueError(
+            f"{type(motion).__name__} has no closed form; arbitrary precision needs one"
+        )
+    h = positive(h, "h (sample interval)")
+    samples = positive_int(samples, "samples")
+    digits = positive_int(digits, "digits")
+    if digits < 17:
+        raise ValueError(f"digits must be at least 17 (float64 is ~16), got {digits}")
+    if samples > MAX_MP_SAMPLES:
+        raise ValueError(
+            f"{samples} samples exceed the arbitrary-precision limit of {MAX_MP_SAMPLES}; "
+            "shorten the duration or lower the sample rate"
+        )
+    return h, samples, digits
+
+
+def run_windowed_mp(motion: Motion, algorithm: WindowedAlgorithm, *, h: float, updates: int,
+                    digits: int = 50, t0: float = 0.0) -> MpSolution:
+    """Run a windowed (designed) algorithm on a closed-form motion in arbitrary precision.
+
+    History samples before ``t0`` come from the motion itself, so the first
+    update at ``t0`` already has its full window; outputs are at
+    ``t0 + j·update·h``, ``j = 0 … updates``.
+    """
+    if not isinstance(algorithm, WindowedAlgorithm):
+        raise ValueError(f"algorithm must be a WindowedAlgorithm, got {type(algorithm).__name__}")
+    h, updates, digits = _check_run(motion, h, updates, digits)
+    u = algorithm.update
+    with mpmath.workdps(digits):
+        hm = mpmath.mpf(h)
+        tm0 = mpmath.mpf(t0)
+        lo = min(0, min(algorithm.offsets))
+        hi = (updates - 1) * u + algorithm.span
+        if algorithm.input == "increment":
+            samples = {k: motion.increment_mp(tm0 + k * hm, tm0 + (k + 1) * hm)
+                       for k in range(lo, hi + 1)}
+            sa, sb = mpmath.mpf(1), mpmath.mpf(1)
+        else:
+            samples = {k: motion.rate_mp(tm0 + k * hm) for k in range(lo, hi + 1)}
+            sa, sb = hm, hm * hm
+        w = [sa * _mpf(x) for x in algorithm.weights]
+        pairs = [(i, j, sb * _mpf(c)) for (i, j), c in
+                 zip(algorithm.pairs, algorithm.pair_coefficients, strict=True) if c != 0]
+        phis = []
+        for j in range(updates):
+            window = [samples[j * u + o] for o in algorithm.offsets]
+            phis.append(_reference.windowed_rotvec(window, w, pairs, mpmath.mpf(0)))
+        q = _reference.chain(phis, [motion.attitude_mp(tm0)], 1, MPMATH)
+        t_out = [tm0 + j * u * hm for j in range(updates + 1)]
+        return _errors(motion, q, t_out, np.zeros(len(q), int), digits)
 
 
 def _log(dq):
@@ -92,7 +185,7 @@ def run_mp(
         Must have closed forms (``motion.has_closed_form``).
     coefficients : CoefficientSet
         Coning correction (exact rationals are used when available).
-    structure : {"conventional", "realtime"}
+    structure : {"conventional", "realtime", "single-chain"}
     h : float
         Increment interval (s); taken exactly as the float64 value given.
     samples : int
@@ -103,25 +196,12 @@ def run_mp(
     t0 : float
         Start time (s).
     """
-    if not motion.has_closed_form:
-        raise ValueError(
-            f"{type(motion).__name__} has no closed form; arbitrary precision needs one"
-        )
     if structure not in STRUCTURES:
         raise ValueError(f"unknown structure {structure!r}; choose one of {', '.join(STRUCTURES)}")
-    h = positive(h, "h (sample interval)")
-    samples = positive_int(samples, "samples")
-    digits = positive_int(digits, "digits")
-    if digits < 17:
-        raise ValueError(f"digits must be at least 17 (float64 is ~16), got {digits}")
+    h, samples, digits = _check_run(motion, h, samples, digits)
     n = coefficients.n
     if samples < n:
         raise ValueError(f"N = {n} subsamples need at least {n} increments, got {samples}")
-    if samples > MAX_MP_SAMPLES:
-        raise ValueError(
-            f"{samples} increments exceed the arbitrary-precision limit of {MAX_MP_SAMPLES}; "
-            "shorten the duration or lower the sample rate"
-        )
     with mpmath.workdps(digits):
         hm = mpmath.mpf(h)
         tm0 = mpmath.mpf(t0)
@@ -134,18 +214,13 @@ def run_mp(
             q = _reference.conventional(theta, _mp_matrix(coefficients), q0, MPMATH)
             t_out = edges[::n]
             chain = np.zeros(len(q), int)
-        else:
+        elif structure == "realtime":
             ks = [_mp_matrix(s) for s in startup_sets(coefficients)]
             q = _reference.realtime(theta, ks, q0, MPMATH)
             t_out = edges
             chain = np.arange(len(q)) % n
-        err = np.empty((len(q), 3))
-        ang = np.empty(len(q))
-        for i, (qe, tt) in enumerate(zip(q, t_out, strict=True)):
-            qt = motion.attitude_mp(tt)
-            qt_conj = (qt[0], -qt[1], -qt[2], -qt[3])
-            v, a = _log(_reference.quat_mul(qe, qt_conj))
-            err[i] = [float(c) for c in v]
-            ang[i] = float(a)
-        t = np.array([float(x) for x in t_out])
-    return MpSolution(t, err, ang, chain, digits)
+        else:
+            q = _reference.chain(_single_chain_phis(theta, coefficients), [q0], 1, MPMATH)
+            t_out = edges
+            chain = np.zeros(len(q), int)
+        return _errors(motion, q, t_out, chain, digits)

@@ -26,12 +26,26 @@ from dataclasses import dataclass
 import numpy as np
 
 from strapdown import _kernels
-from strapdown._validation import as_quaternions, as_vectors, finite_array, positive
+from strapdown._validation import (
+    as_quaternions,
+    as_vectors,
+    finite_array,
+    positive,
+    positive_int,
+)
 from strapdown.coning import CoefficientSet, coefficient_set
 
-__all__ = ["STRUCTURES", "AttitudeSolution", "conventional", "realtime", "run_structure"]
+__all__ = [
+    "STRUCTURES",
+    "AttitudeSolution",
+    "conventional",
+    "realtime",
+    "run_structure",
+    "single_chain",
+    "windowed",
+]
 
-STRUCTURES = ("conventional", "realtime")
+STRUCTURES = ("conventional", "realtime", "single-chain")
 
 
 @dataclass(frozen=True)
@@ -46,8 +60,8 @@ class AttitudeSolution:
         ``q_n_b`` at those times (unit, scalar first).
     structure : str
         ``"conventional"`` or ``"realtime"``.
-    coefficients : CoefficientSet
-        The coning correction used.
+    coefficients : CoefficientSet or None
+        The coning correction used (None for designed/windowed algorithms).
     h : float
         Increment (subsample) interval (s).
     update_period : float
@@ -60,7 +74,7 @@ class AttitudeSolution:
     t: np.ndarray
     q: np.ndarray
     structure: str
-    coefficients: CoefficientSet
+    coefficients: CoefficientSet | None
     h: float
     update_period: float
     chain: np.ndarray
@@ -82,13 +96,7 @@ def _check_inputs(increments, coefficients, h, q0, t0):
         raise ValueError(f"increments must have shape (n, 3), got {theta.shape}")
     h = positive(h, "h (sample interval)")
     t0 = float(finite_array(t0, "t0"))
-    if q0 is None:
-        q0 = np.array([1.0, 0.0, 0.0, 0.0])
-    else:
-        q0 = as_quaternions(q0, "q0")
-        if q0.shape != (4,):
-            raise ValueError(f"q0 must have shape (4,), got {q0.shape}")
-        q0 = q0 / np.linalg.norm(q0)
+    q0 = _unit_q0(q0)
     n = coefficients.n
     if theta.shape[0] < n:
         raise ValueError(
@@ -214,4 +222,99 @@ def run_structure(name: str, increments, coefficients, *, h, t0=0.0, q0=None) ->
         return conventional(increments, coefficients, h=h, t0=t0, q0=q0, tail="drop")
     if name == "realtime":
         return realtime(increments, coefficients, h=h, t0=t0, q0=q0)
+    if name == "single-chain":
+        if coefficients.name not in ("table3", "none"):
+            raise ValueError(
+                "the single chain takes its coefficients from the designer: use "
+                f"'table3' (the classical-coning optimum) or 'none', not {coefficients.name!r}"
+            )
+        n = coefficients.n if coefficients.name == "table3" else 1
+        return single_chain(increments, n, h=h, t0=t0, q0=q0)
     raise ValueError(f"unknown structure {name!r}; choose one of {', '.join(STRUCTURES)}")
+
+
+def windowed(samples, algorithm, *, h: float, t0: float = 0.0, q0=None) -> AttitudeSolution:
+    """Run a :class:`~strapdown.coning.WindowedAlgorithm` on a sample stream.
+
+    Sample ``k`` is the increment over ``[t0 + k h, t0 + (k+1) h]`` or the rate
+    at ``t0 + k h``. The first ``algorithm.history`` samples only feed the
+    first windows: the initial attitude ``q0`` is at ``t0 + history·h`` and
+    each update adds ``algorithm.update`` samples.
+    """
+    from strapdown.coning import WindowedAlgorithm
+
+    if not isinstance(algorithm, WindowedAlgorithm):
+        raise ValueError(f"algorithm must be a WindowedAlgorithm, got {type(algorithm).__name__}")
+    x = as_vectors(samples, "samples")
+    if x.ndim != 2:
+        raise ValueError(f"samples must have shape (n, 3), got {x.shape}")
+    h = positive(h, "h (sample interval)")
+    t0 = float(finite_array(t0, "t0"))
+    q0 = _unit_q0(q0)
+    b0 = algorithm.history
+    last = x.shape[0] - 1 - algorithm.span  # largest admissible update start
+    if last < b0:
+        need = b0 + algorithm.span + 1
+        raise ValueError(f"{algorithm.name!r} needs at least {need} samples, got {x.shape[0]}")
+    starts = np.arange(b0, last + 1, algorithm.update)
+    phi = algorithm.rotation_vectors(x, starts, h)
+    q = np.empty((phi.shape[0] + 1, 4))
+    _kernels.chain_kernel(np.ascontiguousarray(phi), q0[None, :], 1, q)
+    t = t0 + (b0 + np.arange(phi.shape[0] + 1) * algorithm.update) * h
+    return AttitudeSolution(t, q, "windowed", None, h, algorithm.update * h,
+                            np.zeros(t.size, int))
+
+
+def single_chain_coefficients(n: int) -> tuple:
+    """Exact single-chain coefficients ``c_1 … c_{N−1}`` (classical-coning optimum, designer)."""
+    from strapdown.design import derive, single_chain_structure
+
+    return derive(single_chain_structure(n)).coefficients
+
+
+def single_chain_rotation_vectors(theta: np.ndarray, n: int) -> np.ndarray:
+    """``φ_k = θ_k + Σ_m c_m θ_{k−m} × θ_k``; the first N−1 use the k-sample sets (start-up)."""
+    phi = theta.copy()
+    sets = {m: [float(c) for c in single_chain_coefficients(m)] for m in range(2, n + 1)}
+    full = sets.get(n, [])
+    for m, c in enumerate(full, start=1):
+        if c != 0.0 and theta.shape[0] > n - 1:
+            sl = slice(n - 1, None)
+            phi[sl] += c * np.cross(theta[n - 1 - m: theta.shape[0] - m], theta[sl])
+    for k in range(1, min(n - 1, theta.shape[0])):
+        for m, c in enumerate(sets[k + 1], start=1):
+            phi[k] += c * np.cross(theta[k - m], theta[k])
+    return phi
+
+
+def single_chain(increments, n: int, *, h: float, t0: float = 0.0, q0=None) -> AttitudeSolution:
+    """Single-chain high-rate structure: an attitude every h with N-subsample accuracy.
+
+    ``φ_k = θ_k + Σ_{m=1}^{N−1} c_m θ_{k−m} × θ_k``, ``q_k = q_{k−1} ⊗ q(φ_k)``,
+    coefficients from the designer (:func:`strapdown.design.single_chain_structure`),
+    ``c_m = (K_m − (N−m)/2)/N`` in terms of the conventional lag sums. Its
+    classical-coning drift equals the conventional N-subsample drift at the
+    same h, from one chain (no sawtooth). Start-up: increment k < N−1 uses the
+    (k+1)-sample set.
+    """
+    n = positive_int(n, "N (subsamples)")
+    theta = as_vectors(increments, "increments")
+    if theta.ndim != 2 or theta.shape[0] < 1:
+        raise ValueError(f"increments must have shape (n, 3) with n ≥ 1, got {theta.shape}")
+    h = positive(h, "h (sample interval)")
+    t0 = float(finite_array(t0, "t0"))
+    q0 = _unit_q0(q0)
+    phi = single_chain_rotation_vectors(theta, n)
+    q = np.empty((theta.shape[0] + 1, 4))
+    _kernels.chain_kernel(np.ascontiguousarray(phi), q0[None, :], 1, q)
+    t = t0 + np.arange(q.shape[0]) * h
+    return AttitudeSolution(t, q, "single-chain", None, h, h, np.zeros(t.size, int))
+
+
+def _unit_q0(q0) -> np.ndarray:
+    if q0 is None:
+        return np.array([1.0, 0.0, 0.0, 0.0])
+    q0 = as_quaternions(q0, "q0")
+    if q0.shape != (4,):
+        raise ValueError(f"q0 must have shape (4,), got {q0.shape}")
+    return q0 / np.linalg.norm(q0)
