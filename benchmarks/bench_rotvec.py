@@ -15,7 +15,7 @@ import time
 import numpy as np
 
 from strapdown.coning import coefficient_set
-from strapdown.structures import conventional, realtime
+from strapdown.structures import conventional, realtime, single_chain
 
 
 def best_of(fn, repeat: int) -> float:
@@ -43,8 +43,12 @@ def main(argv=None) -> int:
     for n in range(1, 6):
         cs = coefficient_set("table3", n)
         m = a.samples - a.samples % n
-        for name, fn in (("conventional", lambda: conventional(theta[:m], cs, h=1e-4)),
-                         ("realtime", lambda: realtime(theta, cs, h=1e-4))):
+        runs = (
+            ("conventional", lambda cs=cs, m=m: conventional(theta[:m], cs, h=1e-4)),
+            ("realtime", lambda cs=cs: realtime(theta, cs, h=1e-4)),
+            ("single-chain", lambda n=n: single_chain(theta, n, h=1e-4)),
+        )
+        for name, fn in runs:
             rate = a.samples / best_of(fn, a.repeat)
             records.append({"name": f"rotvec-N{n}-{name}", "samples_per_s": rate,
                             "ratio_to_numpy_pass": rate / floor_rate, "peer": None})

@@ -97,7 +97,7 @@ def test_reproduce_li2017_writes_report(tmp_path, capsys):
     assert code == 0
     report = (tmp_path / "report.md").read_text()
     for name in ("table1", "table2", "table3", "table4", "table5", "float64_vs_mp",
-                 "drift_vs_omega_h"):
+                 "drift_vs_omega_h", "single_chain"):
         assert (tmp_path / f"{name}.csv").is_file() and (tmp_path / f"{name}.md").is_file()
     for png in ("drift_vs_omega_h.png", "update_period.png", "realtime_sawtooth.png"):
         assert (tmp_path / png).stat().st_size > 10_000
@@ -108,3 +108,42 @@ def test_reproduce_li2017_writes_report(tmp_path, capsys):
     t4 = (tmp_path / "table4.csv").read_text()
     assert t4.count("differs") == 10  # the 3600 and 7200 °/s rows
     assert not list(tmp_path.glob(".*"))  # no temporary files left behind
+
+
+def test_coefficients_json_contract(capsys):
+    code, out = run(capsys, "coefficients", "--form", "cross-with-last", "--subsamples", "4",
+                    "--json")
+    d = json.loads(out.out)
+    assert code == 0
+    assert d["coefficients"] == ["214/105", "92/105", "18/35"]
+    assert d["terms"] == ["θ3×θ4", "θ2×θ4", "θ1×θ4"]
+    assert d["drift_constant"] == "1/1260" and d["order"] == 8
+
+
+def test_coefficients_polynomial_target_human(capsys):
+    code, out = run(capsys, "coefficients", "--form", "all-pairs", "--subsamples", "3",
+                    "--target", "polynomial")
+    assert code == 0
+    assert "57/80" in out.out and "33/80" in out.out and "+1/80 · a²Ω(Ωh)^4" in out.out
+
+
+def test_coefficients_rate_three_reports_true_order(capsys):
+    _, out = run(capsys, "coefficients", "--form", "rate-three", "--subsamples", "3",
+                 "--ignore-quadrature", "--json")
+    d = json.loads(out.out)
+    assert d["order"] == 8 and d["true_order"] == 4 and d["true_drift_constant"] == "-1/80"
+
+
+def test_coefficients_bad_input(capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["coefficients", "--form", "lag", "--subsamples", "0"])
+    assert exc.value.code == 2
+    assert "positive integer" in capsys.readouterr().err
+
+
+def test_evaluate_single_chain(capsys):
+    _, out = run(capsys, "evaluate", "--structure", "single-chain", "--subsamples", "2",
+                 "--sample-rate-hz", "240", "--duration", "20", "--json")
+    d = json.loads(out.out)
+    assert d["update_period_s"] == pytest.approx(1 / 240)
+    assert d["cone_axis_drift_rad_s"] / d["predicted_drift_rad_s"] == pytest.approx(1, abs=0.01)

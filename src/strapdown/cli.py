@@ -39,10 +39,75 @@ def _add_evaluate(sub) -> None:
     p.add_argument("--subsamples", type=int, default=3, help="N, subsamples per update")
     p.add_argument("--coefficients", choices=list(coefficient_set_names()), default="table3",
                    help="coning coefficient set (default: table3, the classical-coning optimum)")
-    p.add_argument("--structure", choices=["conventional", "realtime"], default="conventional")
+    p.add_argument("--structure", choices=["conventional", "realtime", "single-chain"],
+                   default="conventional",
+                   help="update structure (single-chain: an attitude every h)")
     p.add_argument("--precision", type=int, default=None, metavar="DIGITS",
                    help="run in arbitrary precision with DIGITS significant digits")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+
+
+def _add_coefficients(sub) -> None:
+    from strapdown.design import FORMS, RULES, TARGETS
+
+    p = sub.add_parser(
+        "coefficients",
+        help="derive coning coefficients exactly for an algorithm structure",
+        description="Derive a structure's coefficients in exact rational arithmetic and print "
+        "them with the classical-coning drift law they achieve: drift about the cone axis = "
+        "−drift_constant · a²Ω(Ωh)^order.",
+    )
+    p.add_argument("--form", choices=FORMS, required=True, help="algorithm structure")
+    p.add_argument("--subsamples", type=int, required=True, help="N")
+    p.add_argument("--target", choices=TARGETS, default="coning")
+    p.add_argument("--rule", choices=RULES, default="polynomial",
+                   help="how to settle coefficients the target leaves free")
+    p.add_argument("--previous", type=int, default=None,
+                   help="uncompressed form: increments from earlier intervals (default N)")
+    p.add_argument("--ignore-quadrature", action="store_true",
+                   help="rate input: fit β only, ignoring the α quadrature error (shows what "
+                   "such a derivation claims; the true drift is printed beside it)")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+
+
+def _cmd_coefficients(args) -> int:
+    from strapdown.design import classical_coning_drift, derive, structure_by_name
+
+    st = structure_by_name(args.form, args.subsamples, previous=args.previous)
+    d = derive(st, target=args.target, rule=args.rule, quadrature=not args.ignore_quadrature)
+    rec = d.to_dict()
+    if args.ignore_quadrature and st.input == "rate":
+        order, const = classical_coning_drift(st, d.coefficients)
+        rec["true_order"] = order
+        rec["true_drift_constant"] = None if const is None else _fs(const)
+    if args.json:
+        print(json.dumps(rec, indent=2, ensure_ascii=False))
+        return 0
+    width = max((len(t) for t in rec["terms"]), default=4)
+    lines = [f"form          {rec['form']} ({rec['input']} input)",
+             f"target        {rec['target']} (free coefficients settled by {rec['rule']})"]
+    for term, frac, dec in zip(rec["terms"], rec["coefficients"], rec["decimals"], strict=True):
+        lines.append(f"  {term:{width}s}  {frac:>14s}  {dec: .17g}")
+    if not rec["terms"]:
+        lines.append("  (no cross-product terms)")
+    lines.append(f"drift         {_law(d.drift_constant, d.order)} about the cone axis")
+    if "true_order" in rec:
+        order, const = classical_coning_drift(st, d.coefficients)
+        lines.append(f"true drift    {_law(const, order)} (with the quadrature error)")
+    print("\n".join(lines))
+    return 0
+
+
+def _fs(f) -> str:
+    return f"{f.numerator}/{f.denominator}"
+
+
+def _law(const, order) -> str:
+    """``drift = −c · a²Ω(Ωh)^order`` written with its sign resolved."""
+    if order is None:
+        return "none up to the series length examined"
+    sign = "−" if const > 0 else "+"
+    return f"{sign}{_fs(abs(const))} · a²Ω(Ωh)^{order}"
 
 
 def _add_reproduce(sub) -> None:
@@ -68,7 +133,7 @@ def _cmd_evaluate(args) -> int:
     )
     res = evaluate(cfg).to_dict()
     if args.json:
-        print(json.dumps(res, indent=2))
+        print(json.dumps(res, indent=2, ensure_ascii=False))
         return 0
     arith = f"mpmath, {args.precision} digits" if args.precision else "float64"
     lines = [
@@ -106,6 +171,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--version", action="version", version=f"strapdown {__version__}")
     sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
     _add_evaluate(sub)
+    _add_coefficients(sub)
     _add_reproduce(sub)
     return p
 
@@ -113,7 +179,8 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
-    handlers = {"evaluate": _cmd_evaluate, "reproduce": _cmd_reproduce}
+    handlers = {"evaluate": _cmd_evaluate, "coefficients": _cmd_coefficients,
+                "reproduce": _cmd_reproduce}
     try:
         return handlers[args.command](args)
     except ValueError as exc:

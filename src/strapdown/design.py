@@ -378,17 +378,24 @@ def _consistent(a: sp.Matrix, b: sp.Matrix) -> bool:
     return a.rank() == a.row_join(b).rank()
 
 
-def _prefix_solve(rows, rhs, base_rows=(), base_rhs=()):
-    """Add conditions in order while the system stays consistent; return (A rows, b)."""
+def _prefix_solve(rows, rhs, base_rows=(), base_rhs=(), *, skip: bool = False):
+    """Add conditions in order while the system stays consistent; return (A rows, b).
+
+    ``skip=False`` stops at the first condition that cannot be met (the
+    coning series: that power is the order); ``skip=True`` passes over it and
+    tries the next (polynomial conditions: meet as many as possible).
+    """
     a_rows, b_rows = list(base_rows), list(base_rhs)
     for r, v in zip(rows, rhs, strict=True):
         if all(x == 0 for x in r):
-            if v != 0:
+            if v != 0 and not skip:
                 break  # a condition no coefficient can touch: the order is reached
             continue
         trial_a = _to_sp([*a_rows, r])
         trial_b = _to_sp([[x] for x in [*b_rows, v]])
         if not _consistent(trial_a, trial_b):
+            if skip:
+                continue
             break
         a_rows.append(r)
         b_rows.append(v)
@@ -577,9 +584,9 @@ def _derive(st: Structure, target: str, rule: str, quadrature: bool) -> Design:
         a, b = _prefix_solve(con_rows, con_rhs)
         conditions = len(a)
         if rule == "polynomial":
-            a, b = _prefix_solve(poly_rows, poly_rhs, a, b)
+            a, b = _prefix_solve(poly_rows, poly_rhs, a, b, skip=True)
     else:
-        a, b = _prefix_solve(poly_rows, poly_rhs)
+        a, b = _prefix_solve(poly_rows, poly_rhs, skip=True)
         conditions = len(a)
     u = _min_norm(a, b, ng)
     ug = [_frac(v) for v in u]

@@ -171,13 +171,15 @@ def evaluate(cfg: EvaluationConfig, *, coefficients: CoefficientSet | None = Non
     h, n = cfg.h, cfg.samples
     if cfg.precision is not None:
         s = run_mp(motion, cs, structure=cfg.structure, h=h, samples=n, digits=cfg.precision)
-        t, err, ang, chain = s.t, s.err, s.angle, s.chain
+        t, err, ang, chain, start = s.t, s.err, s.angle, s.chain, s.startup
     else:
         rec = sensors.increments(motion, h, n, errors=cfg.gyro, rng=cfg.seed)
         sol = run_structure(cfg.structure, rec.data, cs, h=h, q0=motion.attitude(0.0))
         err, ang = analysis.attitude_errors(sol.t, sol.q, motion)
-        t, chain = sol.t, sol.chain
-    chains = analysis.chain_drift_rate(t, err, chain, period=motion.period)
+        t, chain, start = sol.t, sol.chain, sol.startup
+    # drift from the first steady-state output on (a start-up transient is a step, not a drift)
+    chains = analysis.chain_drift_rate(t[start:], err[start:], chain[start:],
+                                       period=motion.period)
     if len(chains) == 1:
         drift = chains[0]
     else:

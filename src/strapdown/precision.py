@@ -49,6 +49,8 @@ class MpSolution:
         Interleaved chain index of each output.
     digits : int
         Working precision (significant decimal digits).
+    startup : int
+        First steady-state output (see :class:`strapdown.structures.AttitudeSolution`).
     """
 
     t: np.ndarray
@@ -56,6 +58,7 @@ class MpSolution:
     angle: np.ndarray
     chain: np.ndarray
     digits: int
+    startup: int = 0
 
 
 def _single_chain_phis(theta, coefficients: CoefficientSet):
@@ -92,7 +95,7 @@ def _mpf(v):
     return mpmath.mpf(float(v))
 
 
-def _errors(motion, q, t_out, chain, digits):
+def _errors(motion, q, t_out, chain, digits, startup=0):
     err = np.empty((len(q), 3))
     ang = np.empty(len(q))
     for i, (qe, tt) in enumerate(zip(q, t_out, strict=True)):
@@ -100,7 +103,7 @@ def _errors(motion, q, t_out, chain, digits):
         v, a = _log(_reference.quat_mul(qe, (qt[0], -qt[1], -qt[2], -qt[3])))
         err[i] = [float(c) for c in v]
         ang[i] = float(a)
-    return MpSolution(np.array([float(x) for x in t_out]), err, ang, chain, digits)
+    return MpSolution(np.array([float(x) for x in t_out]), err, ang, chain, digits, startup)
 
 
 def _check_run(motion, h, samples, digits):
@@ -223,4 +226,6 @@ def run_mp(
             q = _reference.chain(_single_chain_phis(theta, coefficients), [q0], 1, MPMATH)
             t_out = edges
             chain = np.zeros(len(q), int)
+            n_sc = n if coefficients.name == "table3" else 1
+            return _errors(motion, q, t_out, chain, digits, min(n_sc - 1, len(q) - 1))
         return _errors(motion, q, t_out, chain, digits)

@@ -69,6 +69,10 @@ class AttitudeSolution:
     chain : ndarray of shape (m,)
         Index of the interleaved chain that produced each output (all 0 for
         the conventional structure).
+    startup : int
+        Index of the first output in steady state: outputs before it precede
+        a start-up transient (N − 1 for the single chain, else 0). Drift is
+        measured from here on.
     """
 
     t: np.ndarray
@@ -78,6 +82,7 @@ class AttitudeSolution:
     h: float
     update_period: float
     chain: np.ndarray
+    startup: int = 0
 
     @property
     def chains(self) -> int:
@@ -308,7 +313,8 @@ def single_chain(increments, n: int, *, h: float, t0: float = 0.0, q0=None) -> A
     q = np.empty((theta.shape[0] + 1, 4))
     _kernels.chain_kernel(np.ascontiguousarray(phi), q0[None, :], 1, q)
     t = t0 + np.arange(q.shape[0]) * h
-    return AttitudeSolution(t, q, "single-chain", None, h, h, np.zeros(t.size, int))
+    return AttitudeSolution(t, q, "single-chain", None, h, h, np.zeros(t.size, int),
+                            min(n - 1, t.size - 1))
 
 
 def _unit_q0(q0) -> np.ndarray:
