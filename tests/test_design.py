@@ -154,3 +154,18 @@ def test_newton_cotes():
 def test_bad_input(call, msg):
     with pytest.raises(ValueError, match=msg):
         call()
+
+
+def test_rate_input_at_arbitrary_nodes_matches_simulation():
+    # non-uniform nodes need a motion sampled off the grid: check the series against the
+    # general mp runner on the grid case built from the same nodes scaled to integers
+    st = D.rate_structure(2, nodes=[0, 1, 2])
+    d = D.derive(st)
+    assert d.structure.weights == (F(1, 3), F(4, 3), F(1, 3))
+    odd = D.derive(D.rate_structure(2, nodes=[0, F(1, 2), 2]))
+    assert odd.order is not None and odd.structure.weights[1] != F(4, 3)
+    prev = D.derive(D.rate_structure(1, nodes=[-1, 0, 1]))  # one sample of history
+    meas, h = _measure(prev, 60, 1e-9)
+    assert abs(meas / prev.predicted_drift(1e-9, OMEGA, h) - 1) <= 0.02
+    with pytest.raises(ValueError, match="increasing"):
+        D.rate_structure(2, nodes=[0, 2, 1])

@@ -48,6 +48,7 @@ from __future__ import annotations
 import functools
 from dataclasses import dataclass
 from fractions import Fraction
+from itertools import pairwise
 from math import factorial
 
 import numpy as np
@@ -218,14 +219,21 @@ def newton_cotes_weights(nodes, update: int) -> tuple[Fraction, ...]:
     return tuple(F(int(sp.fraction(v)[0]), int(sp.fraction(v)[1])) for v in sol)
 
 
-def rate_structure(n: int, layout: str = "all-pairs", weights=None) -> Structure:
-    """Rate samples at the N+1 nodes 0, 1, …, N of an update of N sample intervals.
+def rate_structure(n: int, layout: str = "all-pairs", weights=None, nodes=None) -> Structure:
+    """Rate samples at nodes of an update of N sample intervals (default 0, 1, …, N).
 
-    ``α = h Σ w_n ω_n`` (Newton–Cotes by default: exact for polynomial rates of
-    degree ≤ N), ``β = h² Σ k_ij ω_i × ω_j``.
+    ``α = h Σ w_n ω_n`` (Newton–Cotes on the nodes by default: exact for
+    polynomial rates of degree < number of nodes), ``β = h² Σ k_ij ω_i × ω_j``.
+    ``nodes`` may be any increasing rationals in units of h (e.g. ``[0, 1/2,
+    2]``); negative ones lie in the previous interval.
     """
     n = positive_int(n, "N (sample intervals)")
-    nodes = _nodes(0, n + 1)
+    if nodes is None:
+        nodes = _nodes(0, n + 1)
+    else:
+        nodes = tuple(F(x) for x in nodes)
+        if len(nodes) < 2 or any(b <= a for a, b in pairwise(nodes)):
+            raise ValueError(f"nodes must be at least two increasing values, got {nodes}")
     w = newton_cotes_weights(nodes, n) if weights is None else tuple(F(x) for x in weights)
     pairs, groups = _pairs_and_groups(nodes, layout, 0, n)
     return Structure(f"rate input {layout}, {n} intervals", "rate", n, nodes, w, pairs, groups, n)
