@@ -50,7 +50,7 @@ def test_evaluate_spin_has_null_cone_keys(capsys):
 def test_evaluate_human_readable(capsys):
     code, out = run(capsys, "evaluate", "--duration", "1")
     assert code == 0
-    assert "drift rate" in out.out and "Table 1 law" in out.out and "measured/law" in out.out
+    assert "drift rate" in out.out and "predicted" in out.out and "measured/law" in out.out
 
 
 @pytest.mark.parametrize(
@@ -147,3 +147,24 @@ def test_evaluate_single_chain(capsys):
     d = json.loads(out.out)
     assert d["update_period_s"] == pytest.approx(1 / 240)
     assert d["cone_axis_drift_rad_s"] / d["predicted_drift_rad_s"] == pytest.approx(1, abs=0.01)
+
+
+@pytest.mark.slow
+def test_reproduce_wang_rate_writes_report(tmp_path, capsys):
+    code, _ = run(capsys, "reproduce", "wang-rate", "--out", str(tmp_path))
+    assert code == 0
+    report = (tmp_path / "report.md").read_text()
+    orders = (tmp_path / "orders.csv").read_text().splitlines()
+    assert len(orders) == 8 and all(line.endswith("agrees") for line in orders[1:])
+    for png in ("drift_vs_omega_td.png", "sliding_sawtooth.png"):
+        assert (tmp_path / png).stat().st_size > 10_000 and png in report
+    assert (tmp_path / "rate_vs_increment.csv").is_file()
+
+
+def test_evaluate_rate_algorithm_json(capsys):
+    _, out = run(capsys, "evaluate", "--algorithm", "rate-three", "--structure", "sliding",
+                 "--sample-rate-hz", "120", "--duration", "4", "--json")
+    d = json.loads(out.out)
+    assert d["coefficients"] == "derived"
+    assert d["update_period_s"] == pytest.approx(1 / 120)
+    assert len(d["chain_cone_axis_drift_rad_s"]) == 3

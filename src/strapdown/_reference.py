@@ -100,3 +100,34 @@ def windowed_rotvec(samples, weights, pairs, zero):
         py += c * (az * bx - ax * bz)
         pz += c * (ax * by - ay * bx)
     return px, py, pz
+
+
+def rk4(omega, h, q0, mode, m: Backend):
+    """Reference twin of :func:`strapdown._kernels.rk4_kernel` (mode 0: step 2h; 1: step h)."""
+    stride = 2 if mode == 0 else 1
+    big_h = stride * h
+    half = big_h / 2
+
+    def f(q, w):
+        return tuple(c / 2 for c in quat_mul(q, (m.zero, *w)))
+
+    def axpy(q, s, k):
+        return tuple(a + s * b for a, b in zip(q, k, strict=True))
+
+    out = [tuple(q0)]
+    for j in range((len(omega) - 1) // stride):
+        b = j * stride
+        q = out[-1]
+        if mode == 0:
+            mid = omega[b + 1]
+        else:
+            mid = tuple((u + v) / 2 for u, v in zip(omega[b], omega[b + 1], strict=True))
+        k1 = f(q, omega[b])
+        k2 = f(axpy(q, half, k1), mid)
+        k3 = f(axpy(q, half, k2), mid)
+        k4 = f(axpy(q, big_h, k3), omega[b + stride])
+        new = tuple(qi + big_h / 6 * (a + 2 * b2 + 2 * c + d)
+                    for qi, a, b2, c, d in zip(q, k1, k2, k3, k4, strict=True))
+        inv = 1 / m.sqrt(sum(c * c for c in new))
+        out.append(tuple(c * inv for c in new))
+    return out

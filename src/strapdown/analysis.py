@@ -33,6 +33,7 @@ __all__ = [
     "drift_rate",
     "integrate_attitude_ode",
     "rotation_per_update",
+    "sawtooth_amplitude",
     "table1_prediction",
     "update_period",
 ]
@@ -151,6 +152,29 @@ def chain_drift_rate(t, err, chain, *, period: float | None = None) -> tuple[Dri
         out.append(drift_rate(t[idx], np.asarray(err)[idx], period=period,
                               reference_time=t[idx[0]], h=h))
     return tuple(out)
+
+
+def sawtooth_amplitude(err, chain, window: int) -> np.ndarray:
+    """Peak-to-peak N-periodic component of an error series, per window of samples.
+
+    In each window the error is regressed on a linear trend plus one constant
+    per chain label; the spread of those constants is the sawtooth amplitude.
+    On a single-chain output, pass ``k mod N`` labels to measure what the
+    regression finds in a series with no chains (the noise baseline).
+    """
+    e = np.asarray(err, dtype=np.float64)
+    chain = np.asarray(chain)
+    if e.ndim != 1 or chain.shape != e.shape:
+        raise ValueError(f"err and chain must be 1-D of equal length, got {e.shape}, {chain.shape}")
+    window = positive_int(window, "window")
+    n = int(chain.max()) + 1
+    out = []
+    for w0 in range(0, e.size - window + 1, window):
+        k = np.arange(w0, w0 + window)
+        x = np.column_stack([k - k.mean()] + [(chain[k] == r).astype(float) for r in range(n)])
+        c, *_ = np.linalg.lstsq(x, e[k], rcond=None)
+        out.append(np.ptp(c[1:]))
+    return np.array(out)
 
 
 def table1_prediction(half_angle: float, cone_rate: float, h: float, n: int) -> float:

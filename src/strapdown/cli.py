@@ -35,13 +35,21 @@ def _add_evaluate(sub) -> None:
     p.add_argument("--sample-rate-hz", type=float, default=10_000.0,
                    help="gyro increment rate 1/h (Hz)")
     p.add_argument("--duration", type=float, default=2.0, help="simulated time (s)")
-    p.add_argument("--algorithm", choices=["rotvec"], default="rotvec")
-    p.add_argument("--subsamples", type=int, default=3, help="N, subsamples per update")
-    p.add_argument("--coefficients", choices=list(coefficient_set_names()), default="table3",
-                   help="coning coefficient set (default: table3, the classical-coning optimum)")
-    p.add_argument("--structure", choices=["conventional", "realtime", "single-chain"],
+    p.add_argument("--algorithm", choices=["rotvec", "rate-single", "rate-three", "rk4"],
+                   default="rotvec",
+                   help="rotvec: increments; rate-single, rate-three, rk4: rate samples")
+    p.add_argument("--subsamples", type=int, default=3, help="N, subsamples per update (rotvec)")
+    p.add_argument("--coefficients", choices=[*coefficient_set_names(), "derived", "paper"],
+                   default=None,
+                   help="rotvec: a named set (default table3, the classical-coning optimum); "
+                   "rate algorithms: derived (default) or paper")
+    p.add_argument("--structure",
+                   choices=["conventional", "realtime", "single-chain", "sliding"],
                    default="conventional",
-                   help="update structure (single-chain: an attitude every h)")
+                   help="update structure (single-chain: rotvec every h; sliding: rate-three "
+                   "every td)")
+    p.add_argument("--rk4-step", choices=["2td", "td-interp"], default="2td",
+                   help="rk4: step 2 td with the middle sample, or td with an interpolated middle")
     p.add_argument("--precision", type=int, default=None, metavar="DIGITS",
                    help="run in arbitrary precision with DIGITS significant digits")
     p.add_argument("--json", action="store_true", help="print one JSON object")
@@ -112,7 +120,9 @@ def _law(const, order) -> str:
 
 def _add_reproduce(sub) -> None:
     p = sub.add_parser("reproduce", help="reproduce a paper's tables and figures")
-    p.add_argument("paper", choices=["li2017"], help="which paper")
+    p.add_argument("paper", choices=["li2017", "wang-rate"],
+                   help="li2017: Li & Zhang 2017; wang-rate: the rate-input algorithms of "
+                   "Wang, Wang & Wang (seed 001)")
     p.add_argument("--out", required=True, help="output directory (created; files replaced)")
 
 
@@ -130,6 +140,7 @@ def _cmd_evaluate(args) -> int:
         spin_rate_dps=args.spin_rate_dps, sample_rate_hz=args.sample_rate_hz,
         duration=args.duration, algorithm=args.algorithm, subsamples=args.subsamples,
         coefficients=args.coefficients, structure=args.structure, precision=args.precision,
+        rk4_step=args.rk4_step,
     )
     res = evaluate(cfg).to_dict()
     if args.json:
@@ -138,13 +149,15 @@ def _cmd_evaluate(args) -> int:
     arith = f"mpmath, {args.precision} digits" if args.precision else "float64"
     lines = [
         f"motion        {args.motion}",
-        f"algorithm     {args.algorithm}, N = {args.subsamples}, coefficients {args.coefficients}",
+        f"algorithm     {args.algorithm}" + (f", N = {args.subsamples}" if args.algorithm ==
+                                               "rotvec" else "")
+        + f", coefficients {res['coefficients']}",
         f"structure     {args.structure} (update period {res['update_period_s']:.6g} s)",
         f"arithmetic    {arith}; {res['samples']} increments",
         f"drift rate    [{', '.join(f'{v:.6e}' for v in res['drift_rate_rad_s'])}] rad/s "
         f"({res['drift_method']}, {res['drift_points']} points)",
         f"cone axis     {_fmt(res['cone_axis_drift_rad_s'], ' rad/s')}",
-        f"Table 1 law   {_fmt(res['predicted_drift_rad_s'], ' rad/s')}",
+        f"predicted     {_fmt(res['predicted_drift_rad_s'], ' rad/s')}",
         f"max error     {res['max_error_rad']:.6e} rad",
         f"rms error     {res['rms_error_rad']:.6e} rad",
     ]
@@ -156,9 +169,10 @@ def _cmd_evaluate(args) -> int:
 
 
 def _cmd_reproduce(args) -> int:
-    from strapdown.reproduce import li2017
+    from strapdown.reproduce import li2017, wang_rate
 
-    path = li2017.reproduce(args.out, progress=lambda msg: print(msg, file=sys.stderr))
+    module = {"li2017": li2017, "wang-rate": wang_rate}[args.paper]
+    path = module.reproduce(args.out, progress=lambda msg: print(msg, file=sys.stderr))
     print(f"wrote {path}")
     return 0
 

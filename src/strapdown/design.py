@@ -68,6 +68,7 @@ __all__ = [
     "interval_structure",
     "newton_cotes_weights",
     "rate_structure",
+    "rk4_classical_coning_drift",
     "single_chain_structure",
     "structure_by_name",
     "three_period_structure",
@@ -532,6 +533,62 @@ def classical_coning_drift(structure: Structure, coefficients, *, quadrature: bo
         )
     e0, pair_series = _coning_series(structure, terms, quadrature=quadrature)
     return _leading(structure, coeffs, e0, pair_series, terms)
+
+
+def rk4_classical_coning_drift(step: str = "2td", terms: int = 12) -> tuple[int, Fraction]:
+    """Classical-coning drift ``(order, c)`` of quaternion RK4 on rate samples (sympy).
+
+    One normalised RK4 step on ``q̇ = ½ q ⊗ ω`` is ``q ⊗ P/|P|`` with ``P`` a
+    quaternion polynomial in the rate samples, i.e. a rotation-vector
+    algorithm with ``φ = 2 vec(P)`` to the orders that matter; its error
+    enters the same cone-axis drift formula as every other algorithm here.
+    ``step="2td"``: step 2 td with the middle sample; ``"td-interp"``: step td,
+    middle rate = mean of the ends. Takes a few seconds; the results are
+    tabulated in :data:`strapdown.rate.RK4_DRIFT`.
+    """
+    a, x = sp.symbols("a x", positive=True)
+
+    def qmul(p, q):
+        pw, px, py, pz = p
+        qw, qx, qy, qz = q
+        return (pw * qw - px * qx - py * qy - pz * qz, pw * qx + px * qw + py * qz - pz * qy,
+                pw * qy - px * qz + py * qw + pz * qx, pw * qz + px * qy - py * qx + pz * qw)
+
+    def trunc(e):
+        e = sp.expand(e)
+        return sum(e.coeff(a, k) * a**k for k in range(3))
+
+    def omega(t):  # classical coning to O(a²) with Ω = 1
+        return (0, -(a**2) / 2, -a * sp.sin(t), a * sp.cos(t))
+
+    def comb(*terms_):
+        return tuple(sp.Add(*(c * q[i] for c, q in terms_)) for i in range(4))
+
+    if step == "2td":
+        big_h, w1, wm, w4 = 2 * x, omega(-2 * x), omega(-x), omega(0)
+    elif step == "td-interp":
+        big_h, w1, w4 = x, omega(-x), omega(0)
+        wm = tuple((p + q) / 2 for p, q in zip(w1, w4, strict=True))
+    else:
+        raise ValueError(f"step must be '2td' or 'td-interp', got {step!r}")
+    one = (1, 0, 0, 0)
+    half = sp.Rational(1, 2)
+    k1 = comb((half, qmul(one, w1)))
+    k2 = comb((half, qmul(comb((1, one), (big_h / 2, k1)), wm)))
+    k3 = comb((half, qmul(comb((1, one), (big_h / 2, k2)), wm)))
+    k4 = comb((half, qmul(comb((1, one), (big_h, k3)), w4)))
+    p = comb((1, one), (big_h / 6, k1), (big_h / 3, k2), (big_h / 3, k3), (big_h / 6, k4))
+    ph = [trunc(2 * c) for c in p[1:]]
+    tx, ty, tz = -(a**2) / 2 * sp.sin(big_h), a * (1 - sp.cos(big_h)), a * sp.sin(big_h)
+    ex, ey, ez = ph[0] - tx, ph[1] - ty, ph[2] - tz
+    d = (ex + a * ez - half * (ty * ez - tz * ey)
+         + sp.Rational(1, 4) * (ey**2 + ez**2) * sp.cot(big_h / 2))
+    d = sp.expand(sp.expand(d).coeff(a, 2))
+    ser = sp.expand(sp.series(d, x, 0, terms).removeO())
+    lead = min(sp.Poly(ser, x).monoms())[0]
+    units = 2 if step == "2td" else 1  # update period in td
+    c = -sp.Rational(ser.coeff(x, lead)) / units
+    return lead - 1, F(int(sp.fraction(c)[0]), int(sp.fraction(c)[1]))
 
 
 def _fs(f: Fraction) -> str:

@@ -16,21 +16,27 @@ from strapdown import analysis, sensors
 from strapdown._validation import positive, positive_int
 from strapdown.coning import MAX_SUBSAMPLES, CoefficientSet, coefficient_set
 from strapdown.motions import ClassicalConing, Motion, PureSpin, SpinConing
-from strapdown.precision import run_mp
+from strapdown.precision import run_mp, run_rk4_mp, run_windowed_mp
 from strapdown.structures import STRUCTURES, run_structure
 
 __all__ = ["MOTIONS", "Evaluation", "EvaluationConfig", "build_motion", "evaluate"]
 
 MOTIONS = ("coning", "spin", "spin-coning")
-ALGORITHMS = ("rotvec",)
+ALGORITHMS = ("rotvec", "rate-single", "rate-three", "rk4")
+RATE_ALGORITHMS = ("rate-single", "rate-three", "rk4")
 
 
 @dataclass(frozen=True)
 class EvaluationConfig:
     """Everything that defines one evaluation (SI units; degrees only where named).
 
-    ``samples`` is ``round(duration · sample_rate)``, reduced to a multiple of
-    N for the conventional structure so every increment is used.
+    ``samples`` is ``round(duration · sample_rate)`` increments, reduced to a
+    multiple of N for the conventional structure so every increment is used;
+    for rate algorithms it is the number of rate samples covering
+    ``[0, duration]`` (``round(duration · rate) + 1``). ``coefficients=None``
+    means the algorithm's default: ``table3`` for ``rotvec`` (the
+    classical-coning optimum), ``derived`` for the rate algorithms (the
+    designer's set, quadrature error included); ``rk4`` has none.
     """
 
     motion: str = "coning"
@@ -41,8 +47,9 @@ class EvaluationConfig:
     duration: float = 2.0
     algorithm: str = "rotvec"
     subsamples: int = 3
-    coefficients: str = "table3"
+    coefficients: str | None = None
     structure: str = "conventional"
+    rk4_step: str = "2td"
     precision: int | None = None
     gyro: sensors.GyroErrors | None = field(default=None)
     seed: int | None = None
@@ -54,7 +61,23 @@ class EvaluationConfig:
             raise ValueError(
                 f"unknown algorithm {self.algorithm!r}; choose one of {', '.join(ALGORITHMS)}"
             )
-        if self.structure not in STRUCTURES:
+        if self.algorithm in RATE_ALGORITHMS:
+            from strapdown import rate
+
+            if self.structure not in rate.STRUCTURES[self.algorithm]:
+                raise ValueError(
+                    f"{self.algorithm} supports the structures "
+                    f"{', '.join(rate.STRUCTURES[self.algorithm])}, not {self.structure!r}"
+                )
+            if self.algorithm == "rk4":
+                if self.coefficients is not None:
+                    raise ValueError("rk4 has no coefficients; drop --coefficients")
+                if self.rk4_step not in rate.RK4_STEPS:
+                    raise ValueError(f"rk4 step must be one of {', '.join(rate.RK4_STEPS)}")
+            elif self.coefficients not in (None, *rate.COEFFICIENTS):
+                raise ValueError(f"{self.algorithm} takes coefficients "
+                                 f"{' or '.join(rate.COEFFICIENTS)}, not {self.coefficients!r}")
+        elif self.structure not in STRUCTURES:
             raise ValueError(
                 f"unknown structure {self.structure!r}; choose one of {', '.join(STRUCTURES)}"
             )
@@ -80,7 +103,20 @@ class EvaluationConfig:
         return 1.0 / self.sample_rate_hz
 
     @property
+    def resolved_coefficients(self) -> str | None:
+        if self.coefficients is not None or self.algorithm == "rk4":
+            return self.coefficients
+        return "table3" if self.algorithm == "rotvec" else "derived"
+
+    @property
     def samples(self) -> int:
+        if self.algorithm in RATE_ALGORITHMS:
+            n = round(self.duration * self.sample_rate_hz) + 1
+            need = 4 if self.algorithm == "rate-three" else 3 if self.algorithm == "rk4" else 2
+            if n < need:
+                raise ValueError(f"duration {self.duration} s at {self.sample_rate_hz} Hz gives "
+                                 f"{n} rate samples; {self.algorithm} needs at least {need}")
+            return n
         n = round(self.duration * self.sample_rate_hz)
         if self.structure == "conventional":
             n -= n % self.subsamples
@@ -136,7 +172,7 @@ class Evaluation:
             "algorithm": c.algorithm,
             "structure": c.structure,
             "subsamples": c.subsamples,
-            "coefficients": c.coefficients,
+            "coefficients": c.resolved_coefficients,
             "precision_digits": c.precision,
             "drift_rate_rad_s": [float(x) for x in self.drift.rate],
             "cone_axis_drift_rad_s": self.cone_axis_drift,
@@ -165,7 +201,9 @@ def evaluate(cfg: EvaluationConfig, *, coefficients: CoefficientSet | None = Non
     """
     cfg.validate()
     motion = build_motion(cfg)
-    cs = coefficients or coefficient_set(cfg.coefficients, cfg.subsamples)
+    if cfg.algorithm in RATE_ALGORITHMS:
+        return _evaluate_rate(cfg, motion)
+    cs = coefficients or coefficient_set(cfg.resolved_coefficients, cfg.subsamples)
     if cs.n != cfg.subsamples:
         raise ValueError(f"coefficient set has N = {cs.n}, configuration says {cfg.subsamples}")
     h, n = cfg.h, cfg.samples
@@ -177,6 +215,54 @@ def evaluate(cfg: EvaluationConfig, *, coefficients: CoefficientSet | None = Non
         sol = run_structure(cfg.structure, rec.data, cs, h=h, q0=motion.attitude(0.0))
         err, ang = analysis.attitude_errors(sol.t, sol.q, motion)
         t, chain, start = sol.t, sol.chain, sol.startup
+    predicted = None
+    if cfg.motion == "coning" and cs.classical_optimum:
+        predicted = analysis.table1_prediction(motion.half_angle, motion.cone_rate, h, cs.n)
+    return _finish(cfg, motion, t, err, ang, chain, start, predicted,
+                   analysis.update_period(cfg.structure, cs.n, h), n)
+
+
+def _evaluate_rate(cfg: EvaluationConfig, motion: Motion) -> Evaluation:
+    from strapdown import rate
+
+    h, n = cfg.h, cfg.samples
+    coeffs = cfg.resolved_coefficients
+    alg = cfg.algorithm
+    sliding = cfg.structure == "sliding"
+    if cfg.precision is not None:
+        if alg == "rk4":
+            s = run_rk4_mp(motion, h=h, samples=n, step=cfg.rk4_step, digits=cfg.precision)
+        elif alg == "rate-single":
+            s = run_windowed_mp(motion, rate.single_period_algorithm(coeffs), h=h, updates=n - 1,
+                                digits=cfg.precision)
+        elif sliding:
+            s = run_windowed_mp(motion, rate.three_period_algorithm(coeffs), h=h, updates=n - 3,
+                                digits=cfg.precision, sliding=True,
+                                startup=rate.single_period_algorithm(coeffs))
+        else:
+            s = run_windowed_mp(motion, rate.three_period_algorithm(coeffs), h=h,
+                                updates=(n - 1) // 3, digits=cfg.precision)
+        t, err, ang, chain = s.t, s.err, s.angle, s.chain
+    else:
+        rec = sensors.rate_samples(motion, h, n, errors=cfg.gyro, rng=cfg.seed)
+        sol = rate.rate_attitude(rec.t, rec.data, algorithm=alg, structure=cfg.structure,
+                                 coefficients=coeffs or "derived", rk4_step=cfg.rk4_step,
+                                 q0=motion.attitude(0.0))
+        err, ang = analysis.attitude_errors(sol.t, sol.q, motion)
+        t, chain = sol.t, sol.chain
+    predicted = None
+    if cfg.motion == "coning":
+        order, c = rate.predicted_drift_law(alg, coefficients=coeffs or "derived",
+                                            rk4_step=cfg.rk4_step)
+        if order is not None:
+            predicted = (-float(c) * motion.half_angle**2 * motion.cone_rate
+                         * (motion.cone_rate * h) ** order)
+    period = {"rate-single": h, "rate-three": h if sliding else 3 * h,
+              "rk4": 2 * h if cfg.rk4_step == "2td" else h}[alg]
+    return _finish(cfg, motion, t, err, ang, chain, 0, predicted, period, n)
+
+
+def _finish(cfg, motion, t, err, ang, chain, start, predicted, update_period, samples):
     # drift from the first steady-state output on (a start-up transient is a step, not a drift)
     chains = analysis.chain_drift_rate(t[start:], err[start:], chain[start:],
                                        period=motion.period)
@@ -188,11 +274,8 @@ def evaluate(cfg: EvaluationConfig, *, coefficients: CoefficientSet | None = Non
             chains[0].method + f" (mean of {len(chains)} chains)",
             sum(d.points for d in chains),
         )
-    predicted = None
-    if cfg.motion == "coning" and cs.classical_optimum:
-        predicted = analysis.table1_prediction(motion.half_angle, motion.cone_rate, h, cs.n)
     return Evaluation(
         config=cfg, t=t, err=err, angle=ang, chain=chain, drift=drift, chain_drifts=chains,
-        cone_axis=motion.cone_axis, predicted=predicted,
-        update_period=analysis.update_period(cfg.structure, cs.n, h), samples=n,
+        cone_axis=motion.cone_axis, predicted=predicted, update_period=update_period,
+        samples=samples,
     )

@@ -27,7 +27,7 @@ from strapdown.coning import CoefficientSet, WindowedAlgorithm
 from strapdown.motions import Motion
 from strapdown.structures import STRUCTURES, startup_sets
 
-__all__ = ["MAX_MP_SAMPLES", "MpSolution", "run_mp", "run_windowed_mp"]
+__all__ = ["MAX_MP_SAMPLES", "MpSolution", "run_mp", "run_rk4_mp", "run_windowed_mp"]
 
 #: Largest number of increments one arbitrary-precision run accepts.
 MAX_MP_SAMPLES = 2_000_000
@@ -125,12 +125,15 @@ def _check_run(motion, h, samples, digits):
 
 
 def run_windowed_mp(motion: Motion, algorithm: WindowedAlgorithm, *, h: float, updates: int,
-                    digits: int = 50, t0: float = 0.0) -> MpSolution:
+                    digits: int = 50, t0: float = 0.0, sliding: bool = False,
+                    startup: WindowedAlgorithm | None = None) -> MpSolution:
     """Run a windowed (designed) algorithm on a closed-form motion in arbitrary precision.
 
     History samples before ``t0`` come from the motion itself, so the first
     update at ``t0`` already has its full window; outputs are at
-    ``t0 + j·update·h``, ``j = 0 … updates``.
+    ``t0 + j·update·h``, ``j = 0 … updates``. With ``sliding=True`` the same
+    runs every sample as in :func:`strapdown.structures.windowed` (``updates``
+    then counts outputs after the start-up).
     """
     if not isinstance(algorithm, WindowedAlgorithm):
         raise ValueError(f"algorithm must be a WindowedAlgorithm, got {type(algorithm).__name__}")
@@ -148,16 +151,31 @@ def run_windowed_mp(motion: Motion, algorithm: WindowedAlgorithm, *, h: float, u
         else:
             samples = {k: motion.rate_mp(tm0 + k * hm) for k in range(lo, hi + 1)}
             sa, sb = hm, hm * hm
-        w = [sa * _mpf(x) for x in algorithm.weights]
-        pairs = [(i, j, sb * _mpf(c)) for (i, j), c in
-                 zip(algorithm.pairs, algorithm.pair_coefficients, strict=True) if c != 0]
-        phis = []
-        for j in range(updates):
-            window = [samples[j * u + o] for o in algorithm.offsets]
-            phis.append(_reference.windowed_rotvec(window, w, pairs, mpmath.mpf(0)))
-        q = _reference.chain(phis, [motion.attitude_mp(tm0)], 1, MPMATH)
-        t_out = [tm0 + j * u * hm for j in range(updates + 1)]
-        return _errors(motion, q, t_out, np.zeros(len(q), int), digits)
+        def phi_of(alg, start):
+            w = [sa * _mpf(x) for x in alg.weights]
+            pairs = [(i, j, sb * _mpf(c)) for (i, j), c in
+                     zip(alg.pairs, alg.pair_coefficients, strict=True) if c != 0]
+            window = [samples[start + o] for o in alg.offsets]
+            return _reference.windowed_rotvec(window, w, pairs, mpmath.mpf(0))
+
+        q0 = motion.attitude_mp(tm0)
+        if not sliding:
+            phis = [phi_of(algorithm, j * u) for j in range(updates)]
+            q = _reference.chain(phis, [q0], 1, MPMATH)
+            t_out = [tm0 + j * u * hm for j in range(updates + 1)]
+            return _errors(motion, q, t_out, np.zeros(len(q), int), digits)
+        if startup is None or startup.update != 1:
+            raise ValueError("the sliding scheme needs a one-sample startup algorithm")
+        first = _reference.chain([phi_of(startup, k) for k in range(u - 1)], [q0], 1, MPMATH)
+        total = updates + u - 1
+        need = total - u + algorithm.span
+        for k in range(hi + 1, need + 1):
+            samples[k] = (motion.increment_mp(tm0 + k * hm, tm0 + (k + 1) * hm)
+                          if algorithm.input == "increment" else motion.rate_mp(tm0 + k * hm))
+        phis = [phi_of(algorithm, k) for k in range(total - u + 1)]
+        q = _reference.chain(phis, first, u, MPMATH)
+        t_out = [tm0 + k * hm for k in range(len(q))]
+        return _errors(motion, q, t_out, np.arange(len(q)) % u, digits)
 
 
 def _log(dq):
@@ -229,3 +247,22 @@ def run_mp(
             n_sc = n if coefficients.name == "table3" else 1
             return _errors(motion, q, t_out, chain, digits, min(n_sc - 1, len(q) - 1))
         return _errors(motion, q, t_out, chain, digits)
+
+
+def run_rk4_mp(motion: Motion, *, h: float, samples: int, step: str = "2td", digits: int = 50,
+               t0: float = 0.0) -> MpSolution:
+    """Quaternion RK4 on exact rate samples in arbitrary precision (see :mod:`strapdown.rate`)."""
+    if step not in ("2td", "td-interp"):
+        raise ValueError(f"step must be '2td' or 'td-interp', got {step!r}")
+    h, samples, digits = _check_run(motion, h, samples, digits)
+    mode = 0 if step == "2td" else 1
+    stride = 2 if mode == 0 else 1
+    if samples < stride + 1:
+        raise ValueError(f"RK4 with step {step} needs at least {stride + 1} samples")
+    with mpmath.workdps(digits):
+        hm = mpmath.mpf(h)
+        tm0 = mpmath.mpf(t0)
+        omega = [motion.rate_mp(tm0 + k * hm) for k in range(samples)]
+        q = _reference.rk4(omega, hm, motion.attitude_mp(tm0), mode, MPMATH)
+        t_out = [tm0 + j * stride * hm for j in range(len(q))]
+        return _errors(motion, q, t_out, np.zeros(len(q), int), digits)

@@ -238,13 +238,19 @@ def run_structure(name: str, increments, coefficients, *, h, t0=0.0, q0=None) ->
     raise ValueError(f"unknown structure {name!r}; choose one of {', '.join(STRUCTURES)}")
 
 
-def windowed(samples, algorithm, *, h: float, t0: float = 0.0, q0=None) -> AttitudeSolution:
+def windowed(samples, algorithm, *, h: float, t0: float = 0.0, q0=None,
+             sliding: bool = False, startup=None) -> AttitudeSolution:
     """Run a :class:`~strapdown.coning.WindowedAlgorithm` on a sample stream.
 
     Sample ``k`` is the increment over ``[t0 + k h, t0 + (k+1) h]`` or the rate
     at ``t0 + k h``. The first ``algorithm.history`` samples only feed the
-    first windows: the initial attitude ``q0`` is at ``t0 + history·h`` and
-    each update adds ``algorithm.update`` samples.
+    first windows: the initial attitude ``q0`` is at ``t0 + history·h``.
+
+    ``sliding=False``: an update every ``algorithm.update`` samples (one chain).
+    ``sliding=True`` (Wang et al.'s sliding scheme): an output every sample,
+    ``q(k) = q(k − U) ⊗ q(φ over [k − U, k])``; the first ``U − 1`` outputs come
+    from ``startup`` (a one-sample WindowedAlgorithm, e.g. the single-period
+    rate algorithm) chained from ``q0``. That is ``U`` interleaved chains.
     """
     from strapdown.coning import WindowedAlgorithm
 
@@ -261,13 +267,29 @@ def windowed(samples, algorithm, *, h: float, t0: float = 0.0, q0=None) -> Attit
     if last < b0:
         need = b0 + algorithm.span + 1
         raise ValueError(f"{algorithm.name!r} needs at least {need} samples, got {x.shape[0]}")
-    starts = np.arange(b0, last + 1, algorithm.update)
+    u = algorithm.update
+    if not sliding:
+        starts = np.arange(b0, last + 1, u)
+        phi = algorithm.rotation_vectors(x, starts, h)
+        q = np.empty((phi.shape[0] + 1, 4))
+        _kernels.chain_kernel(np.ascontiguousarray(phi), q0[None, :], 1, q)
+        t = t0 + (b0 + np.arange(phi.shape[0] + 1) * u) * h
+        return AttitudeSolution(t, q, "windowed", None, h, u * h, np.zeros(t.size, int))
+    if startup is None or startup.update != 1:
+        raise ValueError("the sliding scheme needs a one-sample startup algorithm")
+    first = np.zeros((u, 4))
+    first[0] = q0
+    if u > 1:
+        phis = startup.rotation_vectors(x, np.arange(b0, b0 + u - 1), h)
+        tmp = np.empty((u, 4))
+        _kernels.chain_kernel(np.ascontiguousarray(phis), q0[None, :], 1, tmp)
+        first = tmp
+    starts = np.arange(b0, last + 1)
     phi = algorithm.rotation_vectors(x, starts, h)
-    q = np.empty((phi.shape[0] + 1, 4))
-    _kernels.chain_kernel(np.ascontiguousarray(phi), q0[None, :], 1, q)
-    t = t0 + (b0 + np.arange(phi.shape[0] + 1) * algorithm.update) * h
-    return AttitudeSolution(t, q, "windowed", None, h, algorithm.update * h,
-                            np.zeros(t.size, int))
+    q = np.empty((phi.shape[0] + u, 4))
+    _kernels.chain_kernel(np.ascontiguousarray(phi), first, u, q)
+    k = np.arange(q.shape[0])
+    return AttitudeSolution(t0 + (b0 + k) * h, q, "sliding", None, h, h, k % u)
 
 
 def single_chain_coefficients(n: int) -> tuple:

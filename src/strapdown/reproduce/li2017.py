@@ -27,10 +27,12 @@ from pathlib import Path
 import numpy as np
 
 from strapdown import analysis, sensors
-from strapdown._io import csv_table, markdown_table, save_figure, write_text
+from strapdown._io import markdown_table, write_text
+from strapdown.analysis import sawtooth_amplitude
 from strapdown.coning import TABLE3, coefficient_set, table1_drift_constant
 from strapdown.motions import ClassicalConing
 from strapdown.precision import run_mp
+from strapdown.reproduce._report import ReportWriter, prepare_out
 from strapdown.structures import run_structure
 
 F = Fraction
@@ -113,27 +115,6 @@ def _g(x: float, d: int = 6) -> str:
     return f"{x:.{d}g}"
 
 
-class _Writer:
-    def __init__(self, out: Path):
-        self.out = out
-        self.files: list[str] = []
-
-    def table(self, stem: str, header: list[str], rows: list[list]) -> str:
-        write_text(self.out / f"{stem}.csv", csv_table(header, rows))
-        md = markdown_table(header, rows)
-        write_text(self.out / f"{stem}.md", md)
-        self.files += [f"{stem}.csv", f"{stem}.md"]
-        return md
-
-    def figure(self, name: str, fig) -> str:
-        import matplotlib.pyplot as plt
-
-        save_figure(fig, self.out / name, dpi=120, bbox_inches="tight")
-        plt.close(fig)
-        self.files.append(name)
-        return name
-
-
 def reproduce(out: str | Path, *, progress: Callable[[str], None] | None = None) -> Path:
     """Run the whole reproduction and write it to ``out``; returns the path of ``report.md``."""
     import matplotlib
@@ -142,11 +123,8 @@ def reproduce(out: str | Path, *, progress: Callable[[str], None] | None = None)
     import matplotlib.pyplot as plt
 
     say = progress or (lambda _msg: None)
-    out = Path(out)
-    if out.exists() and not out.is_dir():
-        raise ValueError(f"--out {out} exists and is not a directory")
-    out.mkdir(parents=True, exist_ok=True)
-    w = _Writer(out)
+    out = prepare_out(out)
+    w = ReportWriter(out)
     t_start = time.perf_counter()
     md: list[str] = []
 
@@ -380,13 +358,13 @@ def reproduce(out: str | Path, *, progress: Callable[[str], None] | None = None)
         "![update period](update_period.png)\n",
         *md,
         "\n## Files\n",
-        *[f"- [{f}]({f})" for f in w.files],
+        *w.file_list(),
         "",
     ]
     return write_text(out / "report.md", "\n".join(report))
 
 
-def _single_chain_section(w: _Writer) -> str:
+def _single_chain_section(w: ReportWriter) -> str:
     """What the paper wanted from the real-time structure, done by one chain."""
     from strapdown.structures import single_chain_coefficients
 
@@ -442,23 +420,7 @@ def _paper_setting_note() -> str:
             + markdown_table(["N", "Table 1 drift (rad/s)"], rows))
 
 
-def chain_offsets(e: np.ndarray, chain: np.ndarray, window: int) -> np.ndarray:
-    """Peak-to-peak N-periodic component of ``e`` in consecutive windows.
-
-    In each window the error is regressed on a linear trend plus one constant
-    per chain; the spread of those constants is the sawtooth amplitude.
-    """
-    n = int(chain.max()) + 1
-    out = []
-    for w0 in range(0, e.size - window + 1, window):
-        k = np.arange(w0, w0 + window)
-        x = np.column_stack([k - k.mean()] + [(chain[k] == r).astype(float) for r in range(n)])
-        c, *_ = np.linalg.lstsq(x, e[k], rcond=None)
-        out.append(np.ptp(c[1:]))
-    return np.array(out)
-
-
-def _sawtooth_figure(w: _Writer, plt) -> str:
+def _sawtooth_figure(w: ReportWriter, plt) -> str:
     """Real-time structure: N interleaved chains that never re-converge."""
     n = 3
     motion = ClassicalConing(math.radians(1.0), OMEGA)
@@ -473,11 +435,11 @@ def _sawtooth_figure(w: _Writer, plt) -> str:
         rec = sensors.increments(motion, h, periods * spp, errors=errs, rng=20170618)
         sol = run_structure("realtime", rec.data, cs, h=h, q0=motion.attitude(0.0))
         err, _ = analysis.attitude_errors(sol.t, sol.q, motion)
-        cases[label] = (sol, err[:, 0], chain_offsets(err[:, 0], sol.chain, spp))
+        cases[label] = (sol, err[:, 0], sawtooth_amplitude(err[:, 0], sol.chain, spp))
         # the single chain on the same increments, analysed with the same N-periodic regression
         sc = run_structure("single-chain", rec.data, cs, h=h, q0=motion.attitude(0.0))
         esc, _ = analysis.attitude_errors(sc.t, sc.q, motion)
-        single[label] = chain_offsets(esc[:, 0], np.arange(sc.t.size) % n, spp)
+        single[label] = sawtooth_amplitude(esc[:, 0], np.arange(sc.t.size) % n, spp)
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(7.5, 6.5))
     sol, ex, _ = cases["noise-free"]
     sl = np.arange(ex.size - 12 * n, ex.size)
