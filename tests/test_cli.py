@@ -168,3 +168,20 @@ def test_evaluate_rate_algorithm_json(capsys):
     assert d["coefficients"] == "derived"
     assert d["update_period_s"] == pytest.approx(1 / 120)
     assert len(d["chain_cone_axis_drift_rad_s"]) == 3
+
+
+def test_reproduce_plaksiy_writes_report(tmp_path, capsys):
+    code, _ = run(capsys, "reproduce", "plaksiy2024", "--out", str(tmp_path))
+    assert code == 0
+    t1 = (tmp_path / "table1.csv").read_text().splitlines()
+    assert sum(line.endswith("reproduced") for line in t1[1:]) == 3
+    t3 = (tmp_path / "table3.csv").read_text().splitlines()
+    assert sum(line.endswith("reproduced") for line in t3[1:]) == 3
+    assert "drift_vs_time.png" in (tmp_path / "report.md").read_text()
+
+
+def test_evaluate_krylov_cli(capsys):
+    _, out = run(capsys, "evaluate", "--motion", "krylov", "--krylov-rates", "0.3", "0.5", "0.1",
+                 "--algorithm", "power", "--step", "0.1", "--duration", "200", "--json")
+    d = json.loads(out.out)
+    assert d["accumulated_drift_rad"] == pytest.approx(0.78e-6, rel=0.005)

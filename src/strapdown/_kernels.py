@@ -167,3 +167,76 @@ def rk4_kernel(omega, h, q0, mode, q_out):
         inv = 1.0 / np.sqrt(s)
         for i in range(4):
             q_out[j + 1, i] = tmp[i] * inv
+
+
+@njit(cache=True)
+def quaternion_increment_kernel(theta, mode, alpha, beta, exact, q0, q_out):
+    """Plaksiy's algorithms A1 (mode 1, thirds), A2 (mode 2, halves), A3 (mode 3, halves).
+
+    A1: φ = θ* + α θ⁽¹⁾×θ⁽³⁾ + β θ⁽²⁾×(θ⁽³⁾ − θ⁽¹⁾);  A2: φ = θ* + α θ⁽⁴⁾×θ*;
+    increment ΔΛ from φ by the truncated series (eq. 7) or, with ``exact``, the
+    exponential map. A3 (eq. 8): ΔΛ = [1 − θ*²/8 + θ*⁴/384,
+    ½θ*(1 − θ*²/24) + α θ⁽⁴⁾×θ*]; with ``exact``: exp(θ* + 2α θ⁽⁴⁾×θ*).
+    Λ_n = Λ_{n−1} ∘ ΔΛ_n without renormalisation, as the paper states.
+    """
+    sub = 3 if mode == 1 else 2
+    phi = np.empty(3)
+    d = np.empty(4)
+    q_out[0, :] = q0
+    for n in range(q_out.shape[0] - 1):
+        b = n * sub
+        sx = 0.0
+        sy = 0.0
+        sz = 0.0
+        for i in range(sub):
+            sx += theta[b + i, 0]
+            sy += theta[b + i, 1]
+            sz += theta[b + i, 2]
+        if mode == 1:
+            ax, ay, az = theta[b, 0], theta[b, 1], theta[b, 2]
+            bx, by, bz = theta[b + 1, 0], theta[b + 1, 1], theta[b + 1, 2]
+            cx, cy, cz = theta[b + 2, 0], theta[b + 2, 1], theta[b + 2, 2]
+            ex, ey, ez = cx - ax, cy - ay, cz - az
+            phi[0] = sx + alpha * (ay * cz - az * cy) + beta * (by * ez - bz * ey)
+            phi[1] = sy + alpha * (az * cx - ax * cz) + beta * (bz * ex - bx * ez)
+            phi[2] = sz + alpha * (ax * cy - ay * cx) + beta * (bx * ey - by * ex)
+        else:
+            ax, ay, az = theta[b, 0], theta[b, 1], theta[b, 2]
+            cx = ay * sz - az * sy
+            cy = az * sx - ax * sz
+            cz = ax * sy - ay * sx
+            k = alpha if mode == 2 else 2.0 * alpha
+            if mode == 3 and not exact:
+                th2 = sx * sx + sy * sy + sz * sz
+                d[0] = 1.0 - th2 / 8.0 + th2 * th2 / 384.0
+                f = 0.5 * (1.0 - th2 / 24.0)
+                d[1] = f * sx + alpha * cx
+                d[2] = f * sy + alpha * cy
+                d[3] = f * sz + alpha * cz
+            phi[0] = sx + k * cx
+            phi[1] = sy + k * cy
+            phi[2] = sz + k * cz
+        if exact:
+            ang = np.sqrt(phi[0] * phi[0] + phi[1] * phi[1] + phi[2] * phi[2])
+            half = 0.5 * ang
+            if half < _SMALL:
+                x2 = half * half
+                s = 0.5 * (1.0 - x2 / 6.0 * (1.0 - x2 / 20.0 * (1.0 - x2 / 42.0)))
+            else:
+                s = np.sin(half) / ang
+            d[0] = np.cos(half)
+            d[1] = s * phi[0]
+            d[2] = s * phi[1]
+            d[3] = s * phi[2]
+        elif mode != 3:
+            th2 = phi[0] * phi[0] + phi[1] * phi[1] + phi[2] * phi[2]
+            d[0] = 1.0 - th2 / 8.0 + th2 * th2 / 384.0
+            f = 0.5 * (1.0 - th2 / 24.0)
+            d[1] = f * phi[0]
+            d[2] = f * phi[1]
+            d[3] = f * phi[2]
+        qp = q_out[n]
+        q_out[n + 1, 0] = qp[0] * d[0] - qp[1] * d[1] - qp[2] * d[2] - qp[3] * d[3]
+        q_out[n + 1, 1] = qp[0] * d[1] + qp[1] * d[0] + qp[2] * d[3] - qp[3] * d[2]
+        q_out[n + 1, 2] = qp[0] * d[2] - qp[1] * d[3] + qp[2] * d[0] + qp[3] * d[1]
+        q_out[n + 1, 3] = qp[0] * d[3] + qp[1] * d[2] - qp[2] * d[1] + qp[3] * d[0]

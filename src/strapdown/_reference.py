@@ -131,3 +131,38 @@ def rk4(omega, h, q0, mode, m: Backend):
         inv = 1 / m.sqrt(sum(c * c for c in new))
         out.append(tuple(c * inv for c in new))
     return out
+
+
+def quaternion_increment(theta, mode, alpha, beta, exact, q0, m: Backend):
+    """Reference twin of :func:`strapdown._kernels.quaternion_increment_kernel`."""
+
+    def cross(u, v):
+        return (u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0])
+
+    def trunc(p):
+        th2 = p[0] * p[0] + p[1] * p[1] + p[2] * p[2]
+        f = (1 - th2 / 24) / 2
+        return (1 - th2 / 8 + th2 * th2 / 384, f * p[0], f * p[1], f * p[2])
+
+    sub = 3 if mode == 1 else 2
+    out = [tuple(q0)]
+    for n in range(len(theta) // sub):
+        t = theta[n * sub:(n + 1) * sub]
+        s = tuple(sum(v[i] for v in t) for i in range(3))
+        if mode == 1:
+            c1 = cross(t[0], t[2])
+            c2 = cross(t[1], tuple(t[2][i] - t[0][i] for i in range(3)))
+            phi = tuple(s[i] + alpha * c1[i] + beta * c2[i] for i in range(3))
+        else:
+            c = cross(t[0], s)
+            k = alpha if mode == 2 else 2 * alpha
+            phi = tuple(s[i] + k * c[i] for i in range(3))
+        if exact:
+            d = quat_exp(phi, m)
+        elif mode == 3:
+            t0 = trunc(s)
+            d = (t0[0], *(t0[1 + i] + alpha * c[i] for i in range(3)))
+        else:
+            d = trunc(phi)
+        out.append(quat_mul(out[-1], d))
+    return out

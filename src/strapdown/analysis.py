@@ -24,10 +24,11 @@ from strapdown._validation import (
 from strapdown.coning import table1_drift_constant
 from strapdown.motions import Motion
 from strapdown.rotation.error import attitude_error_angle, attitude_error_vector
-from strapdown.rotation.quaternion import quat_multiply
+from strapdown.rotation.quaternion import quat_conjugate, quat_multiply
 
 __all__ = [
     "DriftEstimate",
+    "accumulated_drift",
     "attitude_errors",
     "chain_drift_rate",
     "drift_rate",
@@ -175,6 +176,19 @@ def sawtooth_amplitude(err, chain, window: int) -> np.ndarray:
         c, *_ = np.linalg.lstsq(x, e[k], rcond=None)
         out.append(np.ptp(c[1:]))
     return np.array(out)
+
+
+def accumulated_drift(q_est, q_true) -> np.ndarray:
+    """Plaksiy's accumulated drift time series: ``2 |vec(Λ_true* ∘ Λ_est)|`` (rad).
+
+    The vector part has the same norm in the body- and reference-frame error
+    conventions; ``q_est`` need not be unit (the paper does not renormalise).
+    The paper's figure of merit is the maximum of this series over the run.
+    """
+    q_est = as_quaternions(q_est, "q_est")
+    q_true = as_quaternions(q_true, "q_true")
+    d = quat_multiply(quat_conjugate(q_true), q_est)
+    return 2.0 * np.linalg.norm(d[..., 1:], axis=-1)
 
 
 def table1_prediction(half_angle: float, cone_rate: float, h: float, n: int) -> float:

@@ -28,16 +28,30 @@ def _add_evaluate(sub) -> None:
         description="Run one configuration (motion → ideal gyro → algorithm) and report drift "
         "and error against exact truth. Human-readable by default, --json for machines.",
     )
-    p.add_argument("--motion", choices=["coning", "spin", "spin-coning"], default="coning")
+    p.add_argument("--motion", choices=["coning", "spin", "spin-coning", "krylov"],
+                   default="coning")
+    p.add_argument("--krylov-rates", type=float, nargs=3, metavar=("K1", "K2", "K3"),
+                   default=(0.15, 0.25, 0.05),
+                   help="krylov motion: angle rates (rad/s), angles k_i·t (Plaksiy)")
     p.add_argument("--half-angle-deg", type=float, default=1.0, help="half cone angle (deg)")
     p.add_argument("--cone-rate-hz", type=float, default=1.0, help="cone frequency Ω/2π (Hz)")
     p.add_argument("--spin-rate-dps", type=float, default=0.0, help="spin rate (deg/s)")
     p.add_argument("--sample-rate-hz", type=float, default=10_000.0,
                    help="gyro increment rate 1/h (Hz)")
     p.add_argument("--duration", type=float, default=2.0, help="simulated time (s)")
-    p.add_argument("--algorithm", choices=["rotvec", "rate-single", "rate-three", "rk4"],
+    p.add_argument("--algorithm",
+                   choices=["rotvec", "rate-single", "rate-three", "rk4", "miller", "panov",
+                            "power"],
                    default="rotvec",
-                   help="rotvec: increments; rate-single, rate-three, rk4: rate samples")
+                   help="rotvec: increments; rate-single, rate-three, rk4: rate samples; "
+                   "miller, panov, power: Plaksiy's A1-A3 on sub-step increments")
+    p.add_argument("--alpha", type=float, default=None, help="miller/panov/power: α")
+    p.add_argument("--beta", type=float, default=None, help="miller: β")
+    p.add_argument("--step", type=float, default=None,
+                   help="miller/panov/power: computation step ΔT (s)")
+    p.add_argument("--exact-exp", action="store_true",
+                   help="miller/panov/power: exact exponential map instead of the truncated "
+                   "series (eq. 7)")
     p.add_argument("--subsamples", type=int, default=3, help="N, subsamples per update (rotvec)")
     p.add_argument("--coefficients", choices=[*coefficient_set_names(), "derived", "paper"],
                    default=None,
@@ -120,9 +134,9 @@ def _law(const, order) -> str:
 
 def _add_reproduce(sub) -> None:
     p = sub.add_parser("reproduce", help="reproduce a paper's tables and figures")
-    p.add_argument("paper", choices=["li2017", "wang-rate"],
+    p.add_argument("paper", choices=["li2017", "wang-rate", "plaksiy2024"],
                    help="li2017: Li & Zhang 2017; wang-rate: the rate-input algorithms of "
-                   "Wang, Wang & Wang (seed 001)")
+                   "Wang, Wang & Wang (seed 001); plaksiy2024: Plaksiy's Krylov-model study")
     p.add_argument("--out", required=True, help="output directory (created; files replaced)")
 
 
@@ -140,7 +154,8 @@ def _cmd_evaluate(args) -> int:
         spin_rate_dps=args.spin_rate_dps, sample_rate_hz=args.sample_rate_hz,
         duration=args.duration, algorithm=args.algorithm, subsamples=args.subsamples,
         coefficients=args.coefficients, structure=args.structure, precision=args.precision,
-        rk4_step=args.rk4_step,
+        rk4_step=args.rk4_step, krylov_rates=tuple(args.krylov_rates), alpha=args.alpha,
+        beta=args.beta, step=args.step, exact_exp=args.exact_exp,
     )
     res = evaluate(cfg).to_dict()
     if args.json:
@@ -151,7 +166,7 @@ def _cmd_evaluate(args) -> int:
         f"motion        {args.motion}",
         f"algorithm     {args.algorithm}" + (f", N = {args.subsamples}" if args.algorithm ==
                                                "rotvec" else "")
-        + f", coefficients {res['coefficients']}",
+        + (f", coefficients {res['coefficients']}" if res["coefficients"] else ""),
         f"structure     {args.structure} (update period {res['update_period_s']:.6g} s)",
         f"arithmetic    {arith}; {res['samples']} increments",
         f"drift rate    [{', '.join(f'{v:.6e}' for v in res['drift_rate_rad_s'])}] rad/s "
@@ -161,6 +176,8 @@ def _cmd_evaluate(args) -> int:
         f"max error     {res['max_error_rad']:.6e} rad",
         f"rms error     {res['rms_error_rad']:.6e} rad",
     ]
+    if res["accumulated_drift_rad"] is not None:
+        lines.append(f"accum. drift  {res['accumulated_drift_rad']:.6e} rad (max 2|vec δq|)")
     if res["predicted_drift_rad_s"] and res["cone_axis_drift_rad_s"] is not None:
         ratio = res["cone_axis_drift_rad_s"] / res["predicted_drift_rad_s"]
         lines.append(f"measured/law  {ratio:.6f}")
@@ -169,9 +186,9 @@ def _cmd_evaluate(args) -> int:
 
 
 def _cmd_reproduce(args) -> int:
-    from strapdown.reproduce import li2017, wang_rate
+    from strapdown.reproduce import li2017, plaksiy2024, wang_rate
 
-    module = {"li2017": li2017, "wang-rate": wang_rate}[args.paper]
+    module = {"li2017": li2017, "wang-rate": wang_rate, "plaksiy2024": plaksiy2024}[args.paper]
     path = module.reproduce(args.out, progress=lambda msg: print(msg, file=sys.stderr))
     print(f"wrote {path}")
     return 0

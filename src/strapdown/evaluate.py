@@ -7,6 +7,7 @@ JSON keys.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 
@@ -15,15 +16,16 @@ import numpy as np
 from strapdown import analysis, sensors
 from strapdown._validation import positive, positive_int
 from strapdown.coning import MAX_SUBSAMPLES, CoefficientSet, coefficient_set
-from strapdown.motions import ClassicalConing, Motion, PureSpin, SpinConing
+from strapdown.motions import ClassicalConing, KrylovMotion, Motion, PureSpin, SpinConing
 from strapdown.precision import run_mp, run_rk4_mp, run_windowed_mp
 from strapdown.structures import STRUCTURES, run_structure
 
 __all__ = ["MOTIONS", "Evaluation", "EvaluationConfig", "build_motion", "evaluate"]
 
-MOTIONS = ("coning", "spin", "spin-coning")
-ALGORITHMS = ("rotvec", "rate-single", "rate-three", "rk4")
+MOTIONS = ("coning", "spin", "spin-coning", "krylov")
+ALGORITHMS = ("rotvec", "rate-single", "rate-three", "rk4", "miller", "panov", "power")
 RATE_ALGORITHMS = ("rate-single", "rate-three", "rk4")
+QUATERNION_ALGORITHMS = ("miller", "panov", "power")
 
 
 @dataclass(frozen=True)
@@ -50,6 +52,11 @@ class EvaluationConfig:
     coefficients: str | None = None
     structure: str = "conventional"
     rk4_step: str = "2td"
+    krylov_rates: tuple[float, float, float] = (0.15, 0.25, 0.05)
+    alpha: float | None = None
+    beta: float | None = None
+    step: float | None = None
+    exact_exp: bool = False
     precision: int | None = None
     gyro: sensors.GyroErrors | None = field(default=None)
     seed: int | None = None
@@ -61,6 +68,18 @@ class EvaluationConfig:
             raise ValueError(
                 f"unknown algorithm {self.algorithm!r}; choose one of {', '.join(ALGORITHMS)}"
             )
+        if self.algorithm in QUATERNION_ALGORITHMS:
+            if self.step is None:
+                raise ValueError(f"{self.algorithm} needs --step (the computation step ΔT, s)")
+            positive(self.step, "step")
+            if self.precision is not None:
+                raise ValueError(f"{self.algorithm} runs in float64 only; drop --precision")
+            if self.coefficients is not None:
+                raise ValueError(f"{self.algorithm} takes --alpha/--beta, not --coefficients")
+            if self.beta is not None and self.algorithm != "miller":
+                raise ValueError(f"{self.algorithm} has one coefficient (--alpha)")
+        elif self.alpha is not None or self.beta is not None or self.exact_exp:
+            raise ValueError("--alpha, --beta and --exact-exp belong to miller, panov and power")
         if self.algorithm in RATE_ALGORITHMS:
             from strapdown import rate
 
@@ -77,6 +96,9 @@ class EvaluationConfig:
             elif self.coefficients not in (None, *rate.COEFFICIENTS):
                 raise ValueError(f"{self.algorithm} takes coefficients "
                                  f"{' or '.join(rate.COEFFICIENTS)}, not {self.coefficients!r}")
+        elif self.algorithm in QUATERNION_ALGORITHMS:
+            if self.structure != "conventional":
+                raise ValueError(f"{self.algorithm} has the conventional structure only")
         elif self.structure not in STRUCTURES:
             raise ValueError(
                 f"unknown structure {self.structure!r}; choose one of {', '.join(STRUCTURES)}"
@@ -86,7 +108,11 @@ class EvaluationConfig:
         n = positive_int(self.subsamples, "subsamples N")
         if n > MAX_SUBSAMPLES:
             raise ValueError(f"subsamples N must be at most {MAX_SUBSAMPLES}, got {n}")
-        if self.motion != "spin":
+        if self.motion == "krylov":
+            if len(self.krylov_rates) != 3 or not all(map(math.isfinite, self.krylov_rates)):
+                raise ValueError(f"--krylov-rates needs three finite numbers, got "
+                                 f"{self.krylov_rates}")
+        elif self.motion != "spin":
             if not math.isfinite(self.cone_rate_hz) or self.cone_rate_hz == 0:
                 raise ValueError(f"cone rate must be finite and non-zero, got {self.cone_rate_hz}")
             if not math.isfinite(self.half_angle_deg):
@@ -104,12 +130,17 @@ class EvaluationConfig:
 
     @property
     def resolved_coefficients(self) -> str | None:
-        if self.coefficients is not None or self.algorithm == "rk4":
+        if self.coefficients is not None or self.algorithm in ("rk4", *QUATERNION_ALGORITHMS):
             return self.coefficients
         return "table3" if self.algorithm == "rotvec" else "derived"
 
     @property
     def samples(self) -> int:
+        if self.algorithm in QUATERNION_ALGORITHMS:
+            steps = round(self.duration / self.step)
+            if steps < 1:
+                raise ValueError(f"duration {self.duration} s is shorter than one step")
+            return steps * (3 if self.algorithm == "miller" else 2)
         if self.algorithm in RATE_ALGORITHMS:
             n = round(self.duration * self.sample_rate_hz) + 1
             need = 4 if self.algorithm == "rate-three" else 3 if self.algorithm == "rk4" else 2
@@ -130,6 +161,8 @@ class EvaluationConfig:
 
 def build_motion(cfg: EvaluationConfig) -> Motion:
     """The reference motion a configuration names."""
+    if cfg.motion == "krylov":
+        return KrylovMotion(*map(float, cfg.krylov_rates))
     a = math.radians(cfg.half_angle_deg)
     om = 2.0 * math.pi * cfg.cone_rate_hz
     ws = math.radians(cfg.spin_rate_dps)
@@ -157,6 +190,7 @@ class Evaluation:
     predicted: float | None
     update_period: float
     samples: int
+    accumulated: np.ndarray | None = None
 
     @property
     def cone_axis_drift(self) -> float | None:
@@ -187,7 +221,21 @@ class Evaluation:
             "rms_error_rad": float(np.sqrt(np.mean(self.angle**2))),
             "update_period_s": self.update_period,
             "samples": self.samples,
+            "accumulated_drift_rad": (None if self.accumulated is None
+                                      else float(self.accumulated.max())),
+            **self._quaternion_coefficients(),
         }
+
+    def _quaternion_coefficients(self) -> dict:
+        c = self.config
+        if c.algorithm not in QUATERNION_ALGORITHMS:
+            return {}
+        from strapdown.quaternion_algorithms import STATED
+
+        a0, b0 = STATED[c.algorithm]
+        return {"alpha": a0 if c.alpha is None else c.alpha,
+                "beta": (b0 if c.beta is None else c.beta) if c.algorithm == "miller" else None,
+                "exact_exp": c.exact_exp, "step_s": c.step}
 
 
 def evaluate(cfg: EvaluationConfig, *, coefficients: CoefficientSet | None = None) -> Evaluation:
@@ -203,6 +251,8 @@ def evaluate(cfg: EvaluationConfig, *, coefficients: CoefficientSet | None = Non
     motion = build_motion(cfg)
     if cfg.algorithm in RATE_ALGORITHMS:
         return _evaluate_rate(cfg, motion)
+    if cfg.algorithm in QUATERNION_ALGORITHMS:
+        return _evaluate_quaternion(cfg, motion)
     cs = coefficients or coefficient_set(cfg.resolved_coefficients, cfg.subsamples)
     if cs.n != cfg.subsamples:
         raise ValueError(f"coefficient set has N = {cs.n}, configuration says {cfg.subsamples}")
@@ -260,6 +310,22 @@ def _evaluate_rate(cfg: EvaluationConfig, motion: Motion) -> Evaluation:
     period = {"rate-single": h, "rate-three": h if sliding else 3 * h,
               "rk4": 2 * h if cfg.rk4_step == "2td" else h}[alg]
     return _finish(cfg, motion, t, err, ang, chain, 0, predicted, period, n)
+
+
+def _evaluate_quaternion(cfg: EvaluationConfig, motion: Motion) -> Evaluation:
+    from strapdown.quaternion_algorithms import STATED, QuaternionAlgorithm, quaternion_attitude
+
+    a0, b0 = STATED[cfg.algorithm]
+    alg = QuaternionAlgorithm(cfg.algorithm, a0 if cfg.alpha is None else cfg.alpha,
+                              b0 if cfg.beta is None else cfg.beta, cfg.exact_exp)
+    n = cfg.samples
+    sub = 3 if cfg.algorithm == "miller" else 2
+    rec = sensors.increments(motion, cfg.step / sub, n, errors=cfg.gyro, rng=cfg.seed)
+    sol = quaternion_attitude(rec.data, alg, step=cfg.step, q0=motion.attitude(0.0))
+    err, ang = analysis.attitude_errors(sol.t, sol.q, motion)
+    acc = analysis.accumulated_drift(sol.q, motion.attitude(sol.t))
+    ev = _finish(cfg, motion, sol.t, err, ang, sol.chain, 0, None, cfg.step, n)
+    return dataclasses.replace(ev, accumulated=acc)
 
 
 def _finish(cfg, motion, t, err, ang, chain, start, predicted, update_period, samples):

@@ -32,6 +32,7 @@ from strapdown.rotation.quaternion import quat_conjugate, quat_multiply, quat_ro
 __all__ = [
     "QUADRATURE_NODES",
     "ClassicalConing",
+    "KrylovMotion",
     "Motion",
     "PureSpin",
     "RotationSequenceMotion",
@@ -112,7 +113,8 @@ class _ClosedForm(Motion):
     def _attitude(self, m: Backend, t) -> tuple: ...
 
     @abc.abstractmethod
-    def _increment(self, m: Backend, t_mid, dt) -> tuple: ...
+    def _increment(self, m: Backend, t0, dt) -> tuple:
+        """Exact increment over ``[t0, t0 + dt]`` (formulas anchored at the start edge)."""
 
     @abc.abstractmethod
     def _rate(self, m: Backend, t) -> tuple: ...
@@ -126,9 +128,9 @@ class _ClosedForm(Motion):
         return np.stack(np.broadcast_arrays(*self._rate(NUMPY, t)), axis=-1)
 
     def _increments(self, t0, t1) -> np.ndarray:
-        # Midpoint and width are formed from the edges directly, so no increment
-        # suffers cancellation from a large absolute time.
-        parts = self._increment(NUMPY, 0.5 * (t0 + t1), t1 - t0)
+        # Anchored at the exact start edge t0 with the exact width t1 − t0 (Sterbenz),
+        # phases formed by exact products: no rounded midpoint, no lost phase.
+        parts = self._increment(NUMPY, t0, t1 - t0)
         return np.stack(np.broadcast_arrays(*parts), axis=-1)
 
     @property
@@ -144,7 +146,7 @@ class _ClosedForm(Motion):
     def increment_mp(self, t0, t1) -> tuple:
         t0 = MPMATH.num(t0)
         t1 = MPMATH.num(t1)
-        return self._increment(MPMATH, (t0 + t1) / 2, t1 - t0)
+        return self._increment(MPMATH, t0, t1 - t0)
 
 
 class _ConingAboutX(_ClosedForm):
@@ -195,20 +197,19 @@ class ClassicalConing(_ConingAboutX):
     def _attitude(self, m, t):
         a, om = self._p(m)
         s = m.sin(a / 2)
-        return (m.cos(a / 2) + 0 * t, 0 * t, s * m.cos(om * t), s * m.sin(om * t))
+        return (m.cos(a / 2) + 0 * t, 0 * t, s * m.cos_lin(om, t), s * m.sin_lin(om, t))
 
     def _rate(self, m, t):
         a, om = self._p(m)
         sa = m.sin(a)
-        return (-2 * om * m.sin(a / 2) ** 2 + 0 * t, -om * sa * m.sin(om * t),
-                om * sa * m.cos(om * t))
+        return (-2 * om * m.sin(a / 2) ** 2 + 0 * t, -om * sa * m.sin_lin(om, t),
+                om * sa * m.cos_lin(om, t))
 
-    def _increment(self, m, t_mid, dt):
+    def _increment(self, m, t0, dt):
         a, om = self._p(m)
-        sa = m.sin(a)
-        amp = 2 * sa * m.sin(om * dt / 2)
-        return (-2 * om * m.sin(a / 2) ** 2 * dt, -amp * m.sin(om * t_mid),
-                amp * m.cos(om * t_mid))
+        s = om * m.sin(a)
+        return (-2 * om * m.sin(a / 2) ** 2 * dt, -s * _int_sin(m, om, t0, dt),
+                s * _int_cos(m, om, t0, dt))
 
 
 @dataclass(frozen=True)
@@ -233,13 +234,13 @@ class PureSpin(_ClosedForm):
 
     def _attitude(self, m, t):
         ws = m.num(self.spin_rate)
-        return (m.cos(ws * t / 2), m.sin(ws * t / 2), 0 * t, 0 * t)
+        return (m.cos_lin(ws / 2, t), m.sin_lin(ws / 2, t), 0 * t, 0 * t)
 
     def _rate(self, m, t):
         ws = m.num(self.spin_rate)
         return (ws + 0 * t, 0 * t, 0 * t)
 
-    def _increment(self, m, t_mid, dt):
+    def _increment(self, m, t0, dt):
         ws = m.num(self.spin_rate)
         return (ws * dt, 0 * dt, 0 * dt)
 
@@ -290,23 +291,78 @@ class SpinConing(_ConingAboutX):
     def _attitude(self, m, t):
         a, om, ws = self._p(m)
         ca, sa = m.cos(a / 2), m.sin(a / 2)
-        cs, ss = m.cos(ws * t / 2), m.sin(ws * t / 2)
-        cy, sy = sa * m.cos(om * t), sa * m.sin(om * t)
+        cs, ss = m.cos_lin(ws / 2, t), m.sin_lin(ws / 2, t)
+        cy, sy = sa * m.cos_lin(om, t), sa * m.sin_lin(om, t)
         # [ca, 0, cy, sy] ⊗ [cs, ss, 0, 0]
         return (ca * cs, ca * ss, cy * cs + sy * ss, sy * cs - cy * ss)
 
     def _rate(self, m, t):
         a, om, ws = self._p(m)
-        lam = ws - om
         s = om * m.sin(a)
-        return (ws - 2 * om * m.sin(a / 2) ** 2 + 0 * t, s * m.sin(lam * t), s * m.cos(lam * t))
+        sl, cl = _phase(m, (ws, -om), t)
+        return (ws - 2 * om * m.sin(a / 2) ** 2 + 0 * t, s * sl, s * cl)
 
-    def _increment(self, m, t_mid, dt):
+    def _increment(self, m, t0, dt):
         a, om, ws = self._p(m)
-        lam = ws - om
-        s = om * m.sin(a) * dt * m.sinc(lam * dt / 2)
-        return ((ws - 2 * om * m.sin(a / 2) ** 2) * dt, s * m.sin(lam * t_mid),
-                s * m.cos(lam * t_mid))
+        s = om * m.sin(a)
+        return ((ws - 2 * om * m.sin(a / 2) ** 2) * dt, s * _int_sin(m, (ws, -om), t0, dt),
+                s * _int_cos(m, (ws, -om), t0, dt))
+
+
+@dataclass(frozen=True)
+class KrylovMotion(_ClosedForm):
+    """Krylov-angle spherical motion with angles linear in time (Plaksiy, eqs. 2–4).
+
+    ``Λ = Λ1 ∘ Λ2 ∘ Λ3``: ``Λ1`` about axis 3 by ``φ = k1 t``, ``Λ2`` about axis 2
+    by ``ψ = k2 t``, ``Λ3`` about axis 1 by ``v = k3 t`` (Hamilton, so
+    ``q_n_b = q_z(k1 t) ⊗ q_y(k2 t) ⊗ q_x(k3 t)``). Body rates (eq. 4):
+    ``ω1 = k3 − k1 sin k2t``, ``ω2 = k1 cos k2t sin k3t + k2 cos k3t``,
+    ``ω3 = k1 cos k2t cos k3t − k2 sin k3t``. Quasi-coordinates over any
+    interval have closed forms (products of sin/cos of linear arguments,
+    written with ``sinc`` so that equal or zero frequencies are exact).
+
+    Parameters
+    ----------
+    k1, k2, k3 : float
+        Angle rates (rad/s). Plaksiy's printed case is (0.15, 0.25, 0.05).
+    """
+
+    k1: float
+    k2: float
+    k3: float
+
+    def __post_init__(self):
+        finite_array([self.k1, self.k2, self.k3], "krylov rates")
+
+    def _k(self, m):
+        return m.num(self.k1), m.num(self.k2), m.num(self.k3)
+
+    def _attitude(self, m, t):
+        k1, k2, k3 = self._k(m)
+        c1, s1 = m.cos_lin(k1 / 2, t), m.sin_lin(k1 / 2, t)
+        c2, s2 = m.cos_lin(k2 / 2, t), m.sin_lin(k2 / 2, t)
+        c3, s3 = m.cos_lin(k3 / 2, t), m.sin_lin(k3 / 2, t)
+        return (c1 * c2 * c3 + s1 * s2 * s3, c1 * c2 * s3 - s1 * s2 * c3,
+                c1 * s2 * c3 + s1 * c2 * s3, s1 * c2 * c3 - c1 * s2 * s3)
+
+    def _rate(self, m, t):
+        k1, k2, k3 = self._k(m)
+        return (k3 - k1 * m.sin_lin(k2, t),
+                k1 * m.cos_lin(k2, t) * m.sin_lin(k3, t) + k2 * m.cos_lin(k3, t),
+                k1 * m.cos_lin(k2, t) * m.cos_lin(k3, t) - k2 * m.sin_lin(k3, t))
+
+    def _increment(self, m, t0, dt):
+        k1, k2, k3 = self._k(m)
+
+        def isin(lam):
+            return _int_sin(m, lam, t0, dt)
+
+        def icos(lam):
+            return _int_cos(m, lam, t0, dt)
+
+        return (k3 * dt - k1 * isin(k2),
+                k1 / 2 * (isin((k3, k2)) + isin((k3, -k2))) + k2 * icos(k3),
+                k1 / 2 * (icos((k2, -k3)) + icos((k2, k3))) - k2 * isin(k3))
 
 
 class UserMotion(Motion):
@@ -361,6 +417,35 @@ class UserMotion(Motion):
         if w.shape != (*t.shape, 3):
             raise ValueError(f"rate(t) must have shape {(*t.shape, 3)}, got {w.shape}")
         return w
+
+
+def _phase(m: Backend, lams, t):
+    """(sin, cos) of (Σ λ_i)·t, each λ_i·t formed exactly and combined by angle addition.
+
+    A frequency that is a sum (k3 + k2) is never rounded as a sum before it
+    multiplies a large time.
+    """
+    s, c = m.sin_lin(lams[0], t), m.cos_lin(lams[0], t)
+    for lam in lams[1:]:
+        s2, c2 = m.sin_lin(lam, t), m.cos_lin(lam, t)
+        s, c = s * c2 + c * s2, c * c2 - s * s2
+    return s, c
+
+
+def _int_sin(m: Backend, lams, t0, dt):
+    """∫_{t0}^{t0+dt} sin(λt) dt = dt·sinc(λdt/2)·sin(λt0 + λdt/2), λ = Σ lams."""
+    lams = lams if isinstance(lams, tuple) else (lams,)
+    half = sum(lams) * dt / 2
+    s0, c0 = _phase(m, lams, t0)
+    return dt * m.sinc(half) * (s0 * m.cos(half) + c0 * m.sin(half))
+
+
+def _int_cos(m: Backend, lams, t0, dt):
+    """∫_{t0}^{t0+dt} cos(λt) dt, λ = Σ lams."""
+    lams = lams if isinstance(lams, tuple) else (lams,)
+    half = sum(lams) * dt / 2
+    s0, c0 = _phase(m, lams, t0)
+    return dt * m.sinc(half) * (c0 * m.cos(half) - s0 * m.sin(half))
 
 
 _AXES = {"x": 0, "y": 1, "z": 2, "1": 0, "2": 1, "3": 2}
