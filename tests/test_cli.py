@@ -185,3 +185,13 @@ def test_evaluate_krylov_cli(capsys):
                  "--algorithm", "power", "--step", "0.1", "--duration", "200", "--json")
     d = json.loads(out.out)
     assert d["accumulated_drift_rad"] == pytest.approx(0.78e-6, rel=0.005)
+
+
+@pytest.mark.slow
+def test_reproduce_zhang2021_writes_report(tmp_path, capsys):
+    code, _ = run(capsys, "reproduce", "zhang2021", "--out", str(tmp_path))
+    assert code == 0
+    for name in ("flight_control", "navigation", "typos"):
+        assert (tmp_path / f"{name}.csv").is_file()
+    report = (tmp_path / "report.md").read_text()
+    assert "flight_control_errors.png" in report and "navigation_errors.png" in report

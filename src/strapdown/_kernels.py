@@ -240,3 +240,114 @@ def quaternion_increment_kernel(theta, mode, alpha, beta, exact, q0, q_out):
         q_out[n + 1, 1] = qp[0] * d[1] + qp[1] * d[0] + qp[2] * d[3] - qp[3] * d[2]
         q_out[n + 1, 2] = qp[0] * d[2] - qp[1] * d[3] + qp[2] * d[0] + qp[3] * d[1]
         q_out[n + 1, 3] = qp[0] * d[3] + qp[1] * d[2] - qp[2] * d[1] + qp[3] * d[0]
+
+
+@njit(cache=True)
+def _cone_deriv(method, y, wx, wy, wz, out):
+    """Right-hand sides of the cone-angle ODEs (see strapdown.cone_kinematics)."""
+    if method <= 1:  # eq. 7 corrected (0) or as printed (1); y = (δ1, δ2, δ3)
+        e = y[0] - y[2]
+        a = np.cos(e) * wy + np.sin(e) * wz
+        out[0] = (-a if method == 0 else a) / np.sin(y[1])
+        out[1] = -np.sin(e) * wy + np.cos(e) * wz
+        out[2] = wx - np.tan(0.5 * y[1]) * a
+    elif method == 2:  # nutation form; y = (ν_y, ν_z, δ3)
+        ny, nz = y[0], y[1]
+        ang2 = ny * ny + nz * nz
+        ang = np.sqrt(ang2)
+        if ang < 1e-4:
+            c1 = 0.5 - ang2 / 24.0
+            c2 = 1.0 / 6.0 - ang2 / 120.0
+        else:
+            c1 = (1.0 - np.cos(ang)) / ang2
+            c2 = (ang - np.sin(ang)) / (ang2 * ang)
+        # J_r = I − c1 K + c2 K², K = [ν×] with ν = (0, ny, nz); columns 2 and 3 of J_r
+        # K = [[0,-nz,ny],[nz,0,0],[-ny,0,0]]
+        # K² = [[-(ny²+nz²),0,0],[0,-nz²,ny nz],[0,ny nz,-ny²]]
+        j12 = c1 * nz
+        j22 = 1.0 - c2 * nz * nz
+        j32 = c2 * ny * nz
+        j13 = -c1 * ny
+        j23 = c2 * ny * nz
+        j33 = 1.0 - c2 * ny * ny
+        c3, s3 = np.cos(y[2]), np.sin(y[2])
+        rx = wx
+        ry = c3 * wy - s3 * wz
+        rz = s3 * wy + c3 * wz
+        det = j22 * j33 - j23 * j32
+        nyd = (ry * j33 - j23 * rz) / det
+        nzd = (j22 * rz - j32 * ry) / det
+        out[0] = nyd
+        out[1] = nzd
+        out[2] = rx - j12 * nyd - j13 * nzd
+    else:  # z-y-x Euler; y = (yaw, pitch, roll)
+        s, c = np.sin(y[2]), np.cos(y[2])
+        q = wy * s + wz * c
+        out[0] = q / np.cos(y[1])
+        out[1] = wy * c - wz * s
+        out[2] = wx + q * np.tan(y[1])
+
+
+@njit(cache=True)
+def cone_ode_kernel(omega, h, y0, method, switch, out, mode):
+    """RK4 (step 2h, middle = middle sample) for the cone-angle ODEs.
+
+    method 0/1 (eq. 7 corrected/printed) hand over to the nutation form (2)
+    while sin δ2 < switch; ``mode`` receives 1 where the nutation form carried
+    the state. ``out`` rows are (δ1, δ2, δ3) for methods 0–2 and (yaw, pitch,
+    roll) for method 3. Returns the number of hand-overs.
+    """
+    k1 = np.empty(3)
+    k2 = np.empty(3)
+    k3 = np.empty(3)
+    k4 = np.empty(3)
+    tmp = np.empty(3)
+    y = np.empty(3)
+    eq7 = method <= 1
+    sing = False
+    if method == 2 or (eq7 and np.sin(y0[1]) < switch):
+        y[0] = -y0[1] * np.sin(y0[0])
+        y[1] = y0[1] * np.cos(y0[0])
+        y[2] = y0[2]
+        sing = True
+    else:
+        y[:] = y0
+    out[0, :] = y0
+    mode[0] = 1 if (sing and eq7) else 0
+    switches = 0
+    for k in range(out.shape[0] - 1):
+        m = 2 if sing else method
+        b = 2 * k
+        _cone_deriv(m, y, omega[b, 0], omega[b, 1], omega[b, 2], k1)
+        for i in range(3):
+            tmp[i] = y[i] + h * k1[i]
+        _cone_deriv(m, tmp, omega[b + 1, 0], omega[b + 1, 1], omega[b + 1, 2], k2)
+        for i in range(3):
+            tmp[i] = y[i] + h * k2[i]
+        _cone_deriv(m, tmp, omega[b + 1, 0], omega[b + 1, 1], omega[b + 1, 2], k3)
+        for i in range(3):
+            tmp[i] = y[i] + 2.0 * h * k3[i]
+        _cone_deriv(m, tmp, omega[b + 2, 0], omega[b + 2, 1], omega[b + 2, 2], k4)
+        for i in range(3):
+            y[i] = y[i] + (2.0 * h) / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+        if sing:
+            d2 = np.sqrt(y[0] * y[0] + y[1] * y[1])
+            d1 = np.arctan2(-y[0], y[1]) if d2 > 0.0 else 0.0
+            out[k + 1, 0] = d1
+            out[k + 1, 1] = d2
+            out[k + 1, 2] = y[2]
+            if eq7 and np.sin(d2) >= switch:
+                sing = False
+                switches += 1
+                y[0] = d1
+                y[1] = d2
+        else:
+            out[k + 1, :] = y
+            if eq7 and np.sin(y[1]) < switch:
+                sing = True
+                switches += 1
+                d1, d2 = y[0], y[1]
+                y[0] = -d2 * np.sin(d1)
+                y[1] = d2 * np.cos(d1)
+        mode[k + 1] = 1 if (sing and eq7) else 0
+    return switches

@@ -134,9 +134,10 @@ def _law(const, order) -> str:
 
 def _add_reproduce(sub) -> None:
     p = sub.add_parser("reproduce", help="reproduce a paper's tables and figures")
-    p.add_argument("paper", choices=["li2017", "wang-rate", "plaksiy2024"],
+    p.add_argument("paper", choices=["li2017", "wang-rate", "plaksiy2024", "zhang2021"],
                    help="li2017: Li & Zhang 2017; wang-rate: the rate-input algorithms of "
-                   "Wang, Wang & Wang (seed 001); plaksiy2024: Plaksiy's Krylov-model study")
+                   "Wang, Wang & Wang (seed 001); plaksiy2024: Plaksiy's Krylov-model study; "
+                   "zhang2021: Zhang & Yu's cone angles")
     p.add_argument("--out", required=True, help="output directory (created; files replaced)")
 
 
@@ -186,9 +187,10 @@ def _cmd_evaluate(args) -> int:
 
 
 def _cmd_reproduce(args) -> int:
-    from strapdown.reproduce import li2017, plaksiy2024, wang_rate
+    from strapdown.reproduce import li2017, plaksiy2024, wang_rate, zhang2021
 
-    module = {"li2017": li2017, "wang-rate": wang_rate, "plaksiy2024": plaksiy2024}[args.paper]
+    module = {"li2017": li2017, "wang-rate": wang_rate, "plaksiy2024": plaksiy2024,
+              "zhang2021": zhang2021}[args.paper]
     path = module.reproduce(args.out, progress=lambda msg: print(msg, file=sys.stderr))
     print(f"wrote {path}")
     return 0

@@ -32,6 +32,7 @@ from strapdown.rotation.quaternion import quat_conjugate, quat_multiply, quat_ro
 __all__ = [
     "QUADRATURE_NODES",
     "ClassicalConing",
+    "ConeAngleMotion",
     "KrylovMotion",
     "Motion",
     "PureSpin",
@@ -446,6 +447,74 @@ def _int_cos(m: Backend, lams, t0, dt):
     half = sum(lams) * dt / 2
     s0, c0 = _phase(m, lams, t0)
     return dt * m.sinc(half) * (c0 * m.cos(half) - s0 * m.sin(half))
+
+
+class ConeAngleMotion(Motion):
+    """A motion given by cone angles δ1(t), δ2(t), δ3(t) (Zhang & Yu 2021, papers.md).
+
+    ``q_c_b = q_x(δ1) ⊗ q_z(δ2) ⊗ q_x(δ3 − δ1)``; body rates from eq. 6 (exact);
+    increments by Gauss–Legendre quadrature. Classical coning is
+    ``δ1 = Ωt − π/2, δ2 = a, δ3 = 0``; adding ``δ3 = ω_s t`` gives spin + coning.
+
+    Parameters
+    ----------
+    angles, angle_rates : callable
+        ``t → (..., 3)`` (δ1, δ2, δ3) and their time derivatives (rad, rad/s).
+    """
+
+    def __init__(self, angles, angle_rates, *, period=None, cone_axis=(1.0, 0.0, 0.0)):
+        if not callable(angles) or not callable(angle_rates):
+            raise ValueError("angles and angle_rates must be callables of time")
+        self._d = angles
+        self._dd = angle_rates
+        self.period = None if period is None else positive(period, "period")
+        self.cone_axis = None if cone_axis is None else as_vectors(cone_axis, "cone_axis")
+
+    @classmethod
+    def polynomial(cls, start=(0.0, 0.0, 0.0), rates=(0.0, 0.0, 0.0),
+                   accelerations=(0.0, 0.0, 0.0)) -> ConeAngleMotion:
+        """δ_i(t) = start_i + rate_i t + ½ accel_i t² (Zhang & Yu Tables 5–6), rad."""
+        d0 = as_vectors(start, "start")
+        r = as_vectors(rates, "rates")
+        acc = as_vectors(accelerations, "accelerations")
+
+        def angles(t):
+            t = np.asarray(t, dtype=np.float64)[..., None]
+            return d0 + r * t + 0.5 * acc * t * t
+
+        def angle_rates(t):
+            t = np.asarray(t, dtype=np.float64)[..., None]
+            return r + acc * t
+
+        return cls(angles, angle_rates)
+
+    def angles(self, t) -> np.ndarray:
+        """(δ1, δ2, δ3) at ``t``, shape ``t.shape + (3,)``."""
+        t = finite_array(t, "t")
+        d = as_vectors(self._d(t), "angles(t)")
+        if d.shape != (*t.shape, 3):
+            raise ValueError(f"angles(t) must have shape {(*t.shape, 3)}, got {d.shape}")
+        return d
+
+    def attitude(self, t) -> np.ndarray:
+        d = self.angles(t)
+        d1, d2, d3 = d[..., 0], d[..., 1], d[..., 2]
+        qx1 = np.stack([np.cos(d1 / 2), np.sin(d1 / 2), 0 * d1, 0 * d1], -1)
+        qz = np.stack([np.cos(d2 / 2), 0 * d2, 0 * d2, np.sin(d2 / 2)], -1)
+        qx3 = np.stack([np.cos((d3 - d1) / 2), np.sin((d3 - d1) / 2), 0 * d1, 0 * d1], -1)
+        return quat_multiply(quat_multiply(qx1, qz), qx3)
+
+    def rate(self, t) -> np.ndarray:
+        """Eq. 6: ω = (δ̇1(cos δ2 − 1) + δ̇3, −δ̇1 cos e sin δ2 − δ̇2 sin e,
+        −δ̇1 sin e sin δ2 + δ̇2 cos e), e = δ1 − δ3."""
+        d = self.angles(t)
+        dd = as_vectors(self._dd(finite_array(t, "t")), "angle_rates(t)")
+        d1, d2, d3 = d[..., 0], d[..., 1], d[..., 2]
+        r1, r2, r3 = dd[..., 0], dd[..., 1], dd[..., 2]
+        e = d1 - d3
+        return np.stack([r1 * (np.cos(d2) - 1) + r3,
+                         -r1 * np.cos(e) * np.sin(d2) - r2 * np.sin(e),
+                         -r1 * np.sin(e) * np.sin(d2) + r2 * np.cos(e)], -1)
 
 
 _AXES = {"x": 0, "y": 1, "z": 2, "1": 0, "2": 1, "3": 2}

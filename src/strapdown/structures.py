@@ -38,6 +38,7 @@ from strapdown.coning import CoefficientSet, coefficient_set
 __all__ = [
     "STRUCTURES",
     "AttitudeSolution",
+    "chain_rotation_vectors",
     "conventional",
     "realtime",
     "run_structure",
@@ -346,3 +347,17 @@ def _unit_q0(q0) -> np.ndarray:
     if q0.shape != (4,):
         raise ValueError(f"q0 must have shape (4,), got {q0.shape}")
     return q0 / np.linalg.norm(q0)
+
+
+def chain_rotation_vectors(phi, *, update_period: float, t0: float = 0.0,
+                           q0=None) -> AttitudeSolution:
+    """Chain precomputed body rotation vectors: ``q_k = q_{k−1} ⊗ q(φ_k)``."""
+    phi = as_vectors(phi, "phi")
+    if phi.ndim != 2:
+        raise ValueError(f"phi must have shape (n, 3), got {phi.shape}")
+    dt = positive(update_period, "update_period")
+    q0 = _unit_q0(q0)
+    q = np.empty((phi.shape[0] + 1, 4))
+    _kernels.chain_kernel(np.ascontiguousarray(phi), q0[None, :], 1, q)
+    t = float(finite_array(t0, "t0")) + np.arange(q.shape[0]) * dt
+    return AttitudeSolution(t, q, "chained", None, dt, dt, np.zeros(t.size, int))
