@@ -29,9 +29,10 @@ demo: $(STAMP)
 test: $(DEVSTAMP)
 	$(PY) -m pytest -q
 
-## bench: throughput benchmarks (numbers are reported, never asserted)
+## bench: throughput benchmarks with peers (numbers are reported, never asserted)
 bench: $(STAMP)
-	$(PY) benchmarks/bench_rotvec.py
+	$(PY) -m pip install --quiet -e ".[bench]"
+	$(VENV)/bin/strapdown bench
 
 ## lint: ruff
 lint: $(DEVSTAMP)

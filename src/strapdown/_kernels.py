@@ -93,13 +93,14 @@ def realtime_kernel(theta, ks, q0, q_out):
     nsub = ks.shape[0]
     phi = np.empty(3)
     q_out[0, :] = q0
-    for j in range(1, theta.shape[0] + 1):
-        if j < nsub:
-            _rotvec(theta, 0, j, ks[j - 1], phi)
-            _update(q_out[0], phi, q_out[j])
-        else:
-            _rotvec(theta, j - nsub, nsub, ks[nsub - 1], phi)
-            _update(q_out[j - nsub], phi, q_out[j])
+    first = min(nsub - 1, theta.shape[0])
+    for j in range(1, first + 1):  # start-up
+        _rotvec(theta, 0, j, ks[j - 1], phi)
+        _update(q_out[0], phi, q_out[j])
+    kmain = ks[nsub - 1]
+    for j in range(nsub, theta.shape[0] + 1):  # steady: as realtime_steady_kernel
+        _rotvec(theta, j - nsub, nsub, kmain, phi)
+        _update(q_out[j - nsub], phi, q_out[j])
 
 
 @njit(cache=True)
@@ -351,3 +352,83 @@ def cone_ode_kernel(omega, h, y0, method, switch, out, mode):
                 y[1] = d2 * np.cos(d1)
         mode[k + 1] = 1 if (sing and eq7) else 0
     return switches
+
+
+@njit(cache=True)
+def single_chain_kernel(theta, csets, start, g0, q_out):
+    """Single chain: ``φ_i = θ_i + Σ_{p=1}^{m} c[m, p−1] θ_{i−p} × θ_i``, ``q ← q ⊗ q(φ)``.
+
+    ``theta[:start]`` is history (the previous ``start`` increments), new
+    increments follow; ``g0`` is the global index of ``theta[start]``;
+    ``m = min(g, N − 1)`` previous increments are used (start-up rows of
+    ``csets``, shape (N, N − 1)). ``q_out[0]`` holds the attitude before the
+    first new increment; one row is written per new increment.
+    """
+    nm1 = csets.shape[0] - 1
+    phi = np.empty(3)
+    for i in range(start, theta.shape[0]):
+        g = g0 + i - start
+        m = g if g < nm1 else nm1
+        bx, by, bz = theta[i, 0], theta[i, 1], theta[i, 2]
+        phi[0] = bx
+        phi[1] = by
+        phi[2] = bz
+        for p in range(1, m + 1):
+            c = csets[m, p - 1]
+            if c != 0.0:
+                ax, ay, az = theta[i - p, 0], theta[i - p, 1], theta[i - p, 2]
+                phi[0] += c * (ay * bz - az * by)
+                phi[1] += c * (az * bx - ax * bz)
+                phi[2] += c * (ax * by - ay * bx)
+        k = i - start
+        _update(q_out[k], phi, q_out[k + 1])
+
+
+@njit(cache=True)
+def realtime_steady_kernel(theta, k, q_out):
+    """Steady state of the real-time structure, resumable.
+
+    theta = the last N − 1 increments followed by new ones; q_out[:N] = the last N
+    attitudes; writes q_out[N:] — the same operations as the main branch of
+    :func:`realtime_kernel`.
+    """
+    n = k.shape[0]
+    phi = np.empty(3)
+    for j in range(theta.shape[0] - n + 1):
+        _rotvec(theta, j, n, k, phi)
+        _update(q_out[j], phi, q_out[j + n])
+
+
+@njit(cache=True)
+def windowed_kernel(x, offsets, weights, pi, pj, pc, sa, sb, starts, stride, q_out):
+    """Fused windowed algorithm: φ_b = sa Σ w_n x[b+o_n] + sb Σ_p c_p x[b+o_i] × x[b+o_j];
+    ``q_out[r + stride] = q_out[r] ⊗ q(φ_{starts[r]})`` (q_out[:stride] given)."""
+    phi = np.empty(3)
+    nn = offsets.shape[0]
+    win = np.empty((nn, 3))
+    sw = sa * weights
+    sc = sb * pc
+    for r in range(starts.shape[0]):
+        b = starts[r]
+        phi[0] = 0.0
+        phi[1] = 0.0
+        phi[2] = 0.0
+        for n in range(nn):  # the window, loaded once
+            o = b + offsets[n]
+            win[n, 0] = x[o, 0]
+            win[n, 1] = x[o, 1]
+            win[n, 2] = x[o, 2]
+            w = sw[n]
+            phi[0] += w * win[n, 0]
+            phi[1] += w * win[n, 1]
+            phi[2] += w * win[n, 2]
+        for p in range(sc.shape[0]):
+            c = sc[p]
+            i = pi[p]
+            j = pj[p]
+            ax, ay, az = win[i, 0], win[i, 1], win[i, 2]
+            bx, by, bz = win[j, 0], win[j, 1], win[j, 2]
+            phi[0] += c * (ay * bz - az * by)
+            phi[1] += c * (az * bx - ax * bz)
+            phi[2] += c * (ax * by - ay * bx)
+        _update(q_out[r], phi, q_out[r + stride])

@@ -206,10 +206,19 @@ def build_parser() -> argparse.ArgumentParser:
     _add_evaluate(sub)
     _add_coefficients(sub)
     _add_reproduce(sub)
+    b = sub.add_parser("bench", help="throughput benchmarks (ratios to a NumPy pass, peers)",
+                       add_help=False)
+    b.add_argument("args", nargs=argparse.REMAINDER)
     return p
 
 
 def main(argv: list[str] | None = None) -> int:
+    if argv is None:
+        argv = sys.argv[1:]
+    if argv and argv[0] == "bench":  # its own parser (strapdown.bench)
+        from strapdown import bench
+
+        return bench.main(argv[1:])
     parser = build_parser()
     args = parser.parse_args(argv)
     handlers = {"evaluate": _cmd_evaluate, "coefficients": _cmd_coefficients,

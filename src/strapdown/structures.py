@@ -269,28 +269,35 @@ def windowed(samples, algorithm, *, h: float, t0: float = 0.0, q0=None,
         need = b0 + algorithm.span + 1
         raise ValueError(f"{algorithm.name!r} needs at least {need} samples, got {x.shape[0]}")
     u = algorithm.update
+    x = np.ascontiguousarray(x)
     if not sliding:
         starts = np.arange(b0, last + 1, u)
-        phi = algorithm.rotation_vectors(x, starts, h)
-        q = np.empty((phi.shape[0] + 1, 4))
-        _kernels.chain_kernel(np.ascontiguousarray(phi), q0[None, :], 1, q)
-        t = t0 + (b0 + np.arange(phi.shape[0] + 1) * u) * h
+        q = np.empty((starts.size + 1, 4))
+        q[0] = q0
+        _run_windowed(x, algorithm, h, starts, 1, q)
+        t = t0 + (b0 + np.arange(q.shape[0]) * u) * h
         return AttitudeSolution(t, q, "windowed", None, h, u * h, np.zeros(t.size, int))
     if startup is None or startup.update != 1:
         raise ValueError("the sliding scheme needs a one-sample startup algorithm")
-    first = np.zeros((u, 4))
-    first[0] = q0
-    if u > 1:
-        phis = startup.rotation_vectors(x, np.arange(b0, b0 + u - 1), h)
-        tmp = np.empty((u, 4))
-        _kernels.chain_kernel(np.ascontiguousarray(phis), q0[None, :], 1, tmp)
-        first = tmp
     starts = np.arange(b0, last + 1)
-    phi = algorithm.rotation_vectors(x, starts, h)
-    q = np.empty((phi.shape[0] + u, 4))
-    _kernels.chain_kernel(np.ascontiguousarray(phi), first, u, q)
+    q = np.empty((starts.size + u, 4))
+    q[0] = q0
+    if u > 1:
+        _run_windowed(x, startup, h, np.arange(b0, b0 + u - 1), 1, q[:u])
+    _run_windowed(x, algorithm, h, starts, u, q)
     k = np.arange(q.shape[0])
     return AttitudeSolution(t0 + (b0 + k) * h, q, "sliding", None, h, h, k % u)
+
+
+def _run_windowed(x, algorithm, h, starts, stride, q):
+    """Fused kernel call for a WindowedAlgorithm (rates scale α by h and β by h²)."""
+    sa, sb = (1.0, 1.0) if algorithm.input == "increment" else (h, h * h)
+    pairs = np.array(algorithm.pairs, dtype=np.int64).reshape(-1, 2)
+    _kernels.windowed_kernel(x, np.array(algorithm.offsets, dtype=np.int64),
+                             np.array([float(w) for w in algorithm.weights]),
+                             np.ascontiguousarray(pairs[:, 0]), np.ascontiguousarray(pairs[:, 1]),
+                             np.array([float(c) for c in algorithm.pair_coefficients]),
+                             sa, sb, np.asarray(starts, dtype=np.int64), stride, q)
 
 
 def single_chain_coefficients(n: int) -> tuple:
@@ -300,19 +307,14 @@ def single_chain_coefficients(n: int) -> tuple:
     return derive(single_chain_structure(n)).coefficients
 
 
-def single_chain_rotation_vectors(theta: np.ndarray, n: int) -> np.ndarray:
-    """``φ_k = θ_k + Σ_m c_m θ_{k−m} × θ_k``; the first N−1 use the k-sample sets (start-up)."""
-    phi = theta.copy()
-    sets = {m: [float(c) for c in single_chain_coefficients(m)] for m in range(2, n + 1)}
-    full = sets.get(n, [])
-    for m, c in enumerate(full, start=1):
-        if c != 0.0 and theta.shape[0] > n - 1:
-            sl = slice(n - 1, None)
-            phi[sl] += c * np.cross(theta[n - 1 - m: theta.shape[0] - m], theta[sl])
-    for k in range(1, min(n - 1, theta.shape[0])):
-        for m, c in enumerate(sets[k + 1], start=1):
-            phi[k] += c * np.cross(theta[k - m], theta[k])
-    return phi
+def single_chain_table(n: int) -> np.ndarray:
+    """Start-up and steady coefficients, shape (N, N − 1): row m holds c_1 … c_m of the
+    (m+1)-sample single-chain set (row N − 1 is the steady set)."""
+    n = positive_int(n, "N (subsamples)")
+    c = np.zeros((n, max(n - 1, 1)))
+    for m in range(1, n):
+        c[m, :m] = [float(x) for x in single_chain_coefficients(m + 1)]
+    return c
 
 
 def single_chain(increments, n: int, *, h: float, t0: float = 0.0, q0=None) -> AttitudeSolution:
@@ -326,15 +328,15 @@ def single_chain(increments, n: int, *, h: float, t0: float = 0.0, q0=None) -> A
     (k+1)-sample set.
     """
     n = positive_int(n, "N (subsamples)")
-    theta = as_vectors(increments, "increments")
+    theta = np.ascontiguousarray(as_vectors(increments, "increments"))
     if theta.ndim != 2 or theta.shape[0] < 1:
         raise ValueError(f"increments must have shape (n, 3) with n ≥ 1, got {theta.shape}")
     h = positive(h, "h (sample interval)")
     t0 = float(finite_array(t0, "t0"))
     q0 = _unit_q0(q0)
-    phi = single_chain_rotation_vectors(theta, n)
     q = np.empty((theta.shape[0] + 1, 4))
-    _kernels.chain_kernel(np.ascontiguousarray(phi), q0[None, :], 1, q)
+    q[0] = q0
+    _kernels.single_chain_kernel(theta, single_chain_table(n), 0, 0, q)
     t = t0 + np.arange(q.shape[0]) * h
     return AttitudeSolution(t, q, "single-chain", None, h, h, np.zeros(t.size, int),
                             min(n - 1, t.size - 1))
