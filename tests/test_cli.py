@@ -195,3 +195,11 @@ def test_reproduce_zhang2021_writes_report(tmp_path, capsys):
         assert (tmp_path / f"{name}.csv").is_file()
     report = (tmp_path / "report.md").read_text()
     assert "flight_control_errors.png" in report and "navigation_errors.png" in report
+
+
+def test_export_c_cli(tmp_path, capsys):
+    code, out = run(capsys, "export-c", "--algorithm", "rotvec", "--structure", "realtime",
+                    "--subsamples", "4", "--out", str(tmp_path))
+    assert code == 0 and "operations per update" in out.out
+    assert (tmp_path / "sd_rotvec_realtime_n4.c").is_file()
+    assert (tmp_path / "sd_rotvec_realtime_n4.h").is_file()

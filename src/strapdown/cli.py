@@ -132,6 +132,37 @@ def _law(const, order) -> str:
     return f"{sign}{_fs(abs(const))} · a²Ω(Ωh)^{order}"
 
 
+def _add_export(sub) -> None:
+    p = sub.add_parser("export-c", help="generate allocation-free C99 for an algorithm",
+                       description="Write <name>.h and <name>.c: state struct, init, reset, "
+                       "update. Prints the operation counts per update.")
+    p.add_argument("--algorithm", choices=["rotvec", "rate-single", "rate-three", "rk4"],
+                   required=True)
+    p.add_argument("--structure", choices=["conventional", "realtime", "single-chain",
+                                           "sliding"], default="conventional")
+    p.add_argument("--subsamples", type=int, default=3, help="N (rotvec)")
+    p.add_argument("--coefficients", default=None,
+                   help="rotvec: a named set (default table3); rate: derived or paper")
+    p.add_argument("--float", dest="real", choices=["double", "float"], default="double")
+    p.add_argument("--sample-rate-hz", type=float, default=10_000.0,
+                   help="rate algorithms: 1/td, baked into the code")
+    p.add_argument("--name", default=None, help="C identifier prefix (default derived)")
+    p.add_argument("--out", required=True, help="output directory")
+
+
+def _cmd_export(args) -> int:
+    from strapdown.export_c import export_c
+
+    if not args.sample_rate_hz > 0:
+        raise ValueError(f"sample rate must be positive, got {args.sample_rate_hz}")
+    e = export_c(args.out, algorithm=args.algorithm, structure=args.structure,
+                 subsamples=args.subsamples, coefficients=args.coefficients, real=args.real,
+                 h=1.0 / args.sample_rate_hz, name=args.name)
+    print(f"wrote {args.out}/{e.name}.h and {e.name}.c")
+    print("operations per update: " + ", ".join(f"{k} {v}" for k, v in e.ops.items()))
+    return 0
+
+
 def _add_reproduce(sub) -> None:
     p = sub.add_parser("reproduce", help="reproduce a paper's tables and figures")
     p.add_argument("paper", choices=["li2017", "wang-rate", "plaksiy2024", "zhang2021"],
@@ -205,6 +236,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
     _add_evaluate(sub)
     _add_coefficients(sub)
+    _add_export(sub)
     _add_reproduce(sub)
     b = sub.add_parser("bench", help="throughput benchmarks (ratios to a NumPy pass, peers)",
                        add_help=False)
@@ -222,7 +254,7 @@ def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     handlers = {"evaluate": _cmd_evaluate, "coefficients": _cmd_coefficients,
-                "reproduce": _cmd_reproduce}
+                "reproduce": _cmd_reproduce, "export-c": _cmd_export}
     try:
         return handlers[args.command](args)
     except ValueError as exc:
