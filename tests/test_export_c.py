@@ -141,3 +141,28 @@ def test_generated_code_properties(tmp_path):
 def test_bad_export(tmp_path, kw, msg):
     with pytest.raises(ValueError, match=msg):
         export_c(tmp_path, **kw)
+
+
+@pytest.mark.parametrize(("structure", "name", "n"), [("conventional", "miller", 3),
+                                                      ("realtime", "lag", 4),
+                                                      ("conventional", "eq6-printed", 3)])
+def test_other_coefficient_sets_match(tmp_path, structure, name, n):
+    q0 = MOTION.attitude(0.0)
+    e, lib = _build(tmp_path, algorithm="rotvec", structure=structure, subsamples=n,
+                    coefficients=name, h=H)
+    th = _increments()
+    cs = coefficient_set(name, n)
+    m = th.shape[0] - th.shape[0] % n
+    py = (conventional(th[:m], cs, h=H, q0=q0) if structure == "conventional"
+          else realtime(th, cs, h=H, q0=q0)).q
+    c = _drive(e, lib, th, q0)
+    assert np.max(np.abs(c - py)) <= 1e-13
+
+
+def test_rate_paper_coefficients_match(tmp_path):
+    q0 = MOTION.attitude(0.0)
+    e, lib = _build(tmp_path, algorithm="rate-three", structure="conventional",
+                    coefficients="paper", h=H)
+    t, w = _rates()
+    py = rate.rate_attitude(t, w, algorithm="rate-three", coefficients="paper", q0=q0).q
+    assert np.max(np.abs(_drive(e, lib, w, q0) - py)) <= 1e-13
