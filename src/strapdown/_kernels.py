@@ -50,9 +50,10 @@ def _update(qp, phi, out):
     if half < _SMALL:
         x2 = half * half
         s = 0.5 * (1.0 - x2 / 6.0 * (1.0 - x2 / 20.0 * (1.0 - x2 / 42.0)))
+        dw = 1.0 - x2 / 2.0 * (1.0 - x2 / 12.0 * (1.0 - x2 / 30.0 * (1.0 - x2 / 56.0)))
     else:
         s = np.sin(half) / ang
-    dw = np.cos(half)
+        dw = np.cos(half)
     dx = s * phi[0]
     dy = s * phi[1]
     dz = s * phi[2]
@@ -223,9 +224,10 @@ def quaternion_increment_kernel(theta, mode, alpha, beta, exact, q0, q_out):
             if half < _SMALL:
                 x2 = half * half
                 s = 0.5 * (1.0 - x2 / 6.0 * (1.0 - x2 / 20.0 * (1.0 - x2 / 42.0)))
+                d[0] = 1.0 - x2 / 2.0 * (1.0 - x2 / 12.0 * (1.0 - x2 / 30.0 * (1.0 - x2 / 56.0)))
             else:
                 s = np.sin(half) / ang
-            d[0] = np.cos(half)
+                d[0] = np.cos(half)
             d[1] = s * phi[0]
             d[2] = s * phi[1]
             d[3] = s * phi[2]

@@ -69,7 +69,8 @@ def _common(real: str) -> str:
     s = _lit(SMALL_ANGLE, real)
     one = _lit(1.0, real)
     return f"""
-/* q_out = normalise(qp (x) q(phi)); exact exponential map, series below |phi|/2 < {SMALL_ANGLE} */
+/* q_out = normalise(qp (x) q(phi)); exact exponential map, sin/x and cos series below
+   |phi|/2 < {SMALL_ANGLE} (truncation below 3e-22 relative) */
 static void sd_update(const real_t qp[4], const real_t phi[3], real_t q_out[4])
 {{
     real_t ang = {sq}(phi[0] * phi[0] + phi[1] * phi[1] + phi[2] * phi[2]);
@@ -79,10 +80,12 @@ static void sd_update(const real_t qp[4], const real_t phi[3], real_t q_out[4])
         real_t x2 = half * half;
         s = {_lit(0.5, real)} * ({one} - x2 / {_lit(6.0, real)}
             * ({one} - x2 / {_lit(20.0, real)} * ({one} - x2 / {_lit(42.0, real)})));
+        dw = {one} - x2 / {_lit(2.0, real)} * ({one} - x2 / {_lit(12.0, real)}
+            * ({one} - x2 / {_lit(30.0, real)} * ({one} - x2 / {_lit(56.0, real)})));
     }} else {{
         s = {sn}(half) / ang;
+        dw = {cs}(half);
     }}
-    dw = {cs}(half);
     dx = s * phi[0];
     dy = s * phi[1];
     dz = s * phi[2];
@@ -108,8 +111,8 @@ static void sd_cross_add(real_t phi[3], real_t c, const real_t a[3], const real_
 
 #: sd_update on its sin/cos branch, counted from the generated code: |φ| (3 mul, 2 add,
 #: sqrt), half (1 mul), sin/ang (div), 3 mul, quaternion product (16 mul, 12 add),
-#: normalisation (4 mul, 3 add, sqrt, div, 4 mul). Below the small-angle threshold the
-#: sin is replaced by 8 mul/div-free series operations.
+#: normalisation (4 mul, 3 add, sqrt, div, 4 mul). Below the small-angle threshold
+#: (|φ|/2 < 1e-2) sin and cos are replaced by their series (no libm call).
 _UPDATE_OPS = {"mul": 31, "add": 17, "div": 2, "sqrt": 2, "sin": 1, "cos": 1}
 _CROSS_OPS = {"mul": 9, "add": 6}
 

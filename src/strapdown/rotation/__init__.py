@@ -5,9 +5,10 @@ conventions (Hamilton, scalar first, ``q_n_b``).
 
 Small-angle threshold
 ---------------------
-:data:`SMALL_ANGLE` (1e-3): below it ``sin(x)/x`` ratios switch to a Taylor
-series with truncation error below 1e-31 relative, so the exponential and
-logarithm maps are exact to round-off from 1e-300 rad up to π.
+:data:`SMALL_ANGLE` (1e-2): below it ``sin(x)/x`` ratios switch to a Taylor
+series (first omitted term below 3e-22 relative; the compiled kernels also take
+``cos`` from its series), so the exponential and logarithm maps are exact to
+round-off from 1e-300 rad up to π.
 """
 
 from strapdown.rotation._series import SMALL_ANGLE

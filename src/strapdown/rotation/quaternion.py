@@ -118,11 +118,13 @@ def rotvec_from_quat(q) -> np.ndarray:
     v = v * sign[..., None]
     s = np.linalg.norm(v, axis=-1)
     angle = 2.0 * np.arctan2(s, w)
-    # scale = angle / s, with the series 2/w (1 - r²/3 + r⁴/5) in r = s/w for small s/w.
+    # scale = angle / s = 2 atan(r)/(r w), r = s/w; for small r the series
+    # 2/w (1 − r²/3 + r⁴/5 − r⁶/7 + r⁸/9), first omitted term r¹⁰/11 < 1e-21.
     small = s < SMALL_ANGLE * w
     ws = np.where(w == 0.0, 1.0, w)
     r2 = (s / ws) ** 2
-    series = 2.0 / ws * (1.0 - r2 / 3.0 + r2 * r2 / 5.0)
+    series = 2.0 / ws * (1.0 - r2 * (1.0 / 3.0 - r2 * (1.0 / 5.0 - r2 * (1.0 / 7.0
+                                                                      - r2 / 9.0))))
     ss = np.where(s == 0.0, 1.0, s)
     scale = np.where(small, series, angle / ss)
     return scale[..., None] * v
