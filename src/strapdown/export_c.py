@@ -129,6 +129,20 @@ def _times(d, n):
     return {k: v * n for k, v in d.items()}
 
 
+def _init_reset(first_q: str, counter: str) -> str:
+    """C ``init`` (store q0 in ``s->q0`` and ``s->{first_q}``, zero the counter) and ``reset``."""
+    return f"""
+void NAME_init(NAME_state *s, const real_t q0[4])
+{{
+    int i;
+    for (i = 0; i < 4; ++i) {{ s->q0[i] = q0[i]; s->{first_q}[i] = q0[i]; }}
+    s->{counter} = 0;
+}}
+
+void NAME_reset(NAME_state *s) {{ NAME_init(s, s->q0); }}
+"""
+
+
 def _rotvec_terms(k) -> list[tuple[int, int, object]]:
     n = len(k)
     return [(i, j, k[i][j]) for i in range(n) for j in range(i + 1, n) if k[i][j] != 0]
@@ -225,15 +239,7 @@ def _gen_rotvec(algorithm, structure, n, coefficients, real, h):
 static const real_t SC[{n}][{width}] = {{
 {table}
 }};
-
-void NAME_init(NAME_state *s, const real_t q0[4])
-{{
-    int i;
-    for (i = 0; i < 4; ++i) {{ s->q0[i] = q0[i]; s->q[i] = q0[i]; }}
-    s->k = 0;
-}}
-
-void NAME_reset(NAME_state *s) {{ NAME_init(s, s->q0); }}
+{_init_reset("q", "k")}
 
 int NAME_update(NAME_state *s, const real_t th[3], real_t q_out[4])
 {{
@@ -260,15 +266,7 @@ int NAME_update(NAME_state *s, const real_t th[3], real_t q_out[4])
     if structure == "conventional":
         struct = f"    real_t q[4];\n    real_t q0[4];\n    real_t th[{n}][3];\n    int count;"
         phi = _phi_rotvec(terms, "s->th", lambda i: str(i), n, real)
-        body = f"""
-void NAME_init(NAME_state *s, const real_t q0[4])
-{{
-    int i;
-    for (i = 0; i < 4; ++i) {{ s->q0[i] = q0[i]; s->q[i] = q0[i]; }}
-    s->count = 0;
-}}
-
-void NAME_reset(NAME_state *s) {{ NAME_init(s, s->q0); }}
+        body = f"""{_init_reset("q", "count")}
 
 int NAME_update(NAME_state *s, const real_t sample[3], real_t q_out[4])
 {{
@@ -297,15 +295,7 @@ int NAME_update(NAME_state *s, const real_t sample[3], real_t q_out[4])
                       f"\n    }}")
     main_phi = _phi_rotvec(terms, "s->th", lambda i: f"(s->k - {n} + {i}) % {n}", n, real)
     struct = (f"    real_t qh[{n}][4];\n    real_t q0[4];\n    real_t th[{n}][3];\n    long k;")
-    body = f"""
-void NAME_init(NAME_state *s, const real_t q0[4])
-{{
-    int i;
-    for (i = 0; i < 4; ++i) {{ s->q0[i] = q0[i]; s->qh[0][i] = q0[i]; }}
-    s->k = 0;
-}}
-
-void NAME_reset(NAME_state *s) {{ NAME_init(s, s->q0); }}
+    body = f"""{_init_reset("qh[0]", "k")}
 
 int NAME_update(NAME_state *s, const real_t sample[3], real_t q_out[4])
 {{
@@ -395,15 +385,7 @@ def _gen_rate(algorithm, structure, n, coefficients, real, h):
                        _times(_CROSS_OPS, len(alg.pairs)), _UPDATE_OPS)
     body = f"""
 {macro}
-
-void NAME_init(NAME_state *s, const real_t q0[4])
-{{
-    int i;
-    for (i = 0; i < 4; ++i) {{ s->q0[i] = q0[i]; s->qh[0][i] = q0[i]; }}
-    s->k = 0;
-}}
-
-void NAME_reset(NAME_state *s) {{ NAME_init(s, s->q0); }}
+{_init_reset("qh[0]", "k")}
 
 int NAME_update(NAME_state *s, const real_t sample[3], real_t q_out[4])
 {{
@@ -435,15 +417,7 @@ static void f(const real_t q[4], const real_t *w, real_t out[4])
     out[2] = {_lit(0.5, real)} * (q[0] * w[1] - q[1] * w[2] + q[3] * w[0]);
     out[3] = {_lit(0.5, real)} * (q[0] * w[2] + q[1] * w[1] - q[2] * w[0]);
 }}
-
-void NAME_init(NAME_state *s, const real_t q0[4])
-{{
-    int i;
-    for (i = 0; i < 4; ++i) {{ s->q0[i] = q0[i]; s->q[i] = q0[i]; }}
-    s->k = 0;
-}}
-
-void NAME_reset(NAME_state *s) {{ NAME_init(s, s->q0); }}
+{_init_reset("q", "k")}
 
 int NAME_update(NAME_state *s, const real_t sample[3], real_t q_out[4])
 {{

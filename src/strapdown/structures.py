@@ -97,12 +97,7 @@ def _check_inputs(increments, coefficients, h, q0, t0):
             "coefficients must be a CoefficientSet (see strapdown.coning.coefficient_set), "
             f"got {type(coefficients).__name__}"
         )
-    theta = as_vectors(increments, "increments")
-    if theta.ndim != 2:
-        raise ValueError(f"increments must have shape (n, 3), got {theta.shape}")
-    h = positive(h, "h (sample interval)")
-    t0 = float(finite_array(t0, "t0"))
-    q0 = _unit_q0(q0)
+    theta, h, t0, q0 = _stream_inputs(increments, "increments", h, t0, q0)
     n = coefficients.n
     if theta.shape[0] < n:
         raise ValueError(
@@ -257,12 +252,7 @@ def windowed(samples, algorithm, *, h: float, t0: float = 0.0, q0=None,
 
     if not isinstance(algorithm, WindowedAlgorithm):
         raise ValueError(f"algorithm must be a WindowedAlgorithm, got {type(algorithm).__name__}")
-    x = as_vectors(samples, "samples")
-    if x.ndim != 2:
-        raise ValueError(f"samples must have shape (n, 3), got {x.shape}")
-    h = positive(h, "h (sample interval)")
-    t0 = float(finite_array(t0, "t0"))
-    q0 = _unit_q0(q0)
+    x, h, t0, q0 = _stream_inputs(samples, "samples", h, t0, q0)
     b0 = algorithm.history
     last = x.shape[0] - 1 - algorithm.span  # largest admissible update start
     if last < b0:
@@ -340,6 +330,15 @@ def single_chain(increments, n: int, *, h: float, t0: float = 0.0, q0=None) -> A
     t = t0 + np.arange(q.shape[0]) * h
     return AttitudeSolution(t, q, "single-chain", None, h, h, np.zeros(t.size, int),
                             min(n - 1, t.size - 1))
+
+
+def _stream_inputs(samples, name, h, t0, q0):
+    """Validated (samples (n, 3), h, t0, unit q0) of a sample-stream call."""
+    x = as_vectors(samples, name)
+    if x.ndim != 2:
+        raise ValueError(f"{name} must have shape (n, 3), got {x.shape}")
+    return (x, positive(h, "h (sample interval)"), float(finite_array(t0, "t0")),
+            _unit_q0(q0))
 
 
 def _unit_q0(q0) -> np.ndarray:

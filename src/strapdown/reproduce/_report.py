@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import time
+from collections.abc import Callable
 from pathlib import Path
 
 from strapdown._io import csv_table, markdown_table, save_figure, write_text
@@ -43,3 +45,16 @@ class ReportWriter:
     def file_list(self) -> list[str]:
         """Markdown links to every file written."""
         return [f"- [{f}]({f})" for f in self.files]
+
+
+def begin_report(out: str | Path, progress: Callable[[str], None] | None):
+    """Start a report: headless matplotlib, the output directory, its writer, a progress
+    callback and the start time. Returns ``(out, writer, say, plt, t_start)``."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    out = prepare_out(out)
+    say = progress or (lambda _msg: None)
+    return out, ReportWriter(out), say, plt, time.perf_counter()

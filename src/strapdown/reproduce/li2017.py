@@ -32,7 +32,7 @@ from strapdown.analysis import sawtooth_amplitude
 from strapdown.coning import TABLE3, coefficient_set, table1_drift_constant
 from strapdown.motions import ClassicalConing
 from strapdown.precision import run_mp
-from strapdown.reproduce._report import ReportWriter, prepare_out
+from strapdown.reproduce._report import ReportWriter, begin_report
 from strapdown.structures import run_structure
 
 F = Fraction
@@ -117,15 +117,7 @@ def _g(x: float, d: int = 6) -> str:
 
 def reproduce(out: str | Path, *, progress: Callable[[str], None] | None = None) -> Path:
     """Run the whole reproduction and write it to ``out``; returns the path of ``report.md``."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    say = progress or (lambda _msg: None)
-    out = prepare_out(out)
-    w = ReportWriter(out)
-    t_start = time.perf_counter()
+    out, w, say, plt, t_start = begin_report(out, progress)
     md: list[str] = []
 
     # ---------------------------------------------------------------- Table 1

@@ -35,7 +35,7 @@ from strapdown.quaternion_algorithms import (
     quaternion_attitude,
     subintervals,
 )
-from strapdown.reproduce._report import ReportWriter, prepare_out
+from strapdown.reproduce._report import begin_report
 
 K = (0.15, 0.25, 0.05)
 K2 = tuple(2 * k for k in K)
@@ -89,15 +89,7 @@ def _coeffs(name, pair):
 
 def reproduce(out: str | Path, *, progress: Callable[[str], None] | None = None) -> Path:
     """Run the reproduction and write it to ``out``; returns the path of ``report.md``."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    say = progress or (lambda _m: None)
-    out = prepare_out(out)
-    w = ReportWriter(out)
-    t_start = time.perf_counter()
+    out, w, say, plt, t_start = begin_report(out, progress)
     md: list[str] = []
 
     runs = {(k, n): DriftRun(KrylovMotion(*k), n) for k in (K, K2) for n in ALGORITHMS}

@@ -28,7 +28,7 @@ from strapdown import analysis, rate, sensors
 from strapdown._io import write_text
 from strapdown.evaluate import EvaluationConfig, evaluate
 from strapdown.motions import ClassicalConing
-from strapdown.reproduce._report import ReportWriter, prepare_out
+from strapdown.reproduce._report import ReportWriter, begin_report
 
 A_SMALL = 1e-9
 SPP = (600, 240, 120, 60)
@@ -53,15 +53,7 @@ def _cfg(alg, structure, coeffs, step, **kw):
 
 def reproduce(out: str | Path, *, progress: Callable[[str], None] | None = None) -> Path:
     """Run the study and write it to ``out``; returns the path of ``report.md``."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    say = progress or (lambda _m: None)
-    out = prepare_out(out)
-    w = ReportWriter(out)
-    t0 = time.perf_counter()
+    out, w, say, plt, t0 = begin_report(out, progress)
     md: list[str] = []
 
     # ---------------------------------------------------------------- orders

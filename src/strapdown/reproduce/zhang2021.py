@@ -26,7 +26,7 @@ from strapdown.coning import (
     triple_cross_rotation_vectors,
 )
 from strapdown.motions import ConeAngleMotion
-from strapdown.reproduce._report import ReportWriter, prepare_out
+from strapdown.reproduce._report import ReportWriter, begin_report
 from strapdown.rotation.cone_angles import (
     cone_angles_from_dcm,
     cone_angles_from_quat,
@@ -75,15 +75,7 @@ def _errors(angles, truth, d2_min=1e-3):
 
 def reproduce(out: str | Path, *, progress: Callable[[str], None] | None = None) -> Path:
     """Run the reproduction and write it to ``out``; returns the path of ``report.md``."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    say = progress or (lambda _m: None)
-    out = prepare_out(out)
-    w = ReportWriter(out)
-    t_start = time.perf_counter()
+    out, w, say, plt, t_start = begin_report(out, progress)
     md: list[str] = []
     n = round(DURATION * RATE_HZ)
     t = np.arange(n + 1) / RATE_HZ
