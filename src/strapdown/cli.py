@@ -163,6 +163,47 @@ def _cmd_export(args) -> int:
     return 0
 
 
+def _add_run(sub) -> None:
+    p = sub.add_parser("run", help="attitude from a gyro log (CSV, .npy, .npz, .mat)",
+                       description="Validate a gyro log, run an algorithm over it (streamed "
+                       "for increment logs) and write the attitude atomically.")
+    p.add_argument("--imu", required=True, help="input log")
+    kind = p.add_mutually_exclusive_group(required=True)
+    kind.add_argument("--rates", dest="kind", action="store_const", const="rate")
+    kind.add_argument("--increments", dest="kind", action="store_const", const="increment")
+    p.add_argument("--units", required=True,
+                   choices=["rad/s", "deg/s", "rad", "deg"],
+                   help="rates: rad/s or deg/s; increments: rad or deg")
+    p.add_argument("--columns", default="t,gx,gy,gz",
+                   help="CSV columns for time and the three axes (default t,gx,gy,gz)")
+    p.add_argument("--sample-rate-hz", type=float, default=None)
+    p.add_argument("--algorithm", choices=["rotvec", "rate-single", "rate-three", "rk4"],
+                   default="rotvec")
+    p.add_argument("--structure", choices=["conventional", "realtime", "single-chain",
+                                           "sliding"], default="conventional")
+    p.add_argument("--subsamples", type=int, default=3)
+    p.add_argument("--coefficients", default=None)
+    p.add_argument("--angles", choices=["ypr", "cone", "none"], default="ypr")
+    p.add_argument("--out", required=True, help="output .csv or .npz")
+
+
+def _cmd_run(args) -> int:
+    from strapdown.run import run_log
+
+    cols = tuple(c.strip() for c in args.columns.split(","))
+    res = run_log(args.imu, args.out, kind=args.kind, units=args.units,
+                  algorithm=args.algorithm, structure=args.structure,
+                  subsamples=args.subsamples, coefficients=args.coefficients, columns=cols,
+                  sample_rate_hz=args.sample_rate_hz, angles=args.angles)
+    for w in res["warnings"]:
+        print(f"warning: {w}", file=sys.stderr)
+    if res["gaps"]:
+        print(f"warning: {len(res['gaps'])} gap(s), first at data row {res['gaps'][0]}",
+              file=sys.stderr)
+    print(f"wrote {args.out}: {res['outputs']} attitudes from {res['samples']} samples")
+    return 0
+
+
 def _add_reproduce(sub) -> None:
     p = sub.add_parser("reproduce", help="reproduce a paper's tables and figures")
     p.add_argument("paper", choices=["li2017", "wang-rate", "plaksiy2024", "zhang2021"],
@@ -237,6 +278,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_evaluate(sub)
     _add_coefficients(sub)
     _add_export(sub)
+    _add_run(sub)
     _add_reproduce(sub)
     b = sub.add_parser("bench", help="throughput benchmarks (ratios to a NumPy pass, peers)",
                        add_help=False)
@@ -254,7 +296,7 @@ def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     handlers = {"evaluate": _cmd_evaluate, "coefficients": _cmd_coefficients,
-                "reproduce": _cmd_reproduce, "export-c": _cmd_export}
+                "reproduce": _cmd_reproduce, "export-c": _cmd_export, "run": _cmd_run}
     try:
         return handlers[args.command](args)
     except ValueError as exc:

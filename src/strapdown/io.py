@@ -1,0 +1,198 @@
+"""Reading IMU logs and writing attitude, with validation that names the row.
+
+Formats (by suffix): CSV with a header row (columns mapped by name, default
+``t,gx,gy,gz``), NumPy ``.npy`` (``(n, 4)`` ``[t, gx, gy, gz]``) and ``.npz``
+(arrays ``t`` and ``gyro``), MATLAB ``.mat`` (PSINS ``[wm vm t]`` — increments
+in columns 1–3, time last — or BROAD ``imu_gyr`` with ``sampling_rate``).
+
+Every log declares what it holds: rates or increments, and the unit
+(``rad/s``/``deg/s`` for rates, ``rad``/``deg`` for increments). A plausibility
+check warns when magnitudes suggest the other unit (a rate above
+:data:`RATE_PLAUSIBLE_MAX` rad/s declared as rad/s is more likely deg/s).
+Validation raises on NaN or infinity, duplicated or non-monotonic time stamps
+(with the row number, counting the first data row as 1) and reports gaps
+larger than ``gap_tolerance`` sample intervals.
+"""
+
+from __future__ import annotations
+
+import csv
+import io as _io
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from strapdown._io import atomic_path
+
+__all__ = ["RATE_PLAUSIBLE_MAX", "ImuLog", "UnitWarning", "read_imu", "write_attitude"]
+
+#: Largest body rate (rad/s) considered plausible when a log says rad/s (~2000 °/s × 1.75;
+#: spinning shells reach 20 r/s ≈ 126 rad/s, so only beyond 200 rad/s do we suspect deg/s).
+RATE_PLAUSIBLE_MAX = 200.0
+_DEG = np.pi / 180.0
+
+
+class UnitWarning(UserWarning):
+    """Magnitudes in a log suggest a unit other than the one declared."""
+
+
+@dataclass(frozen=True)
+class ImuLog:
+    """A validated gyro log in SI units.
+
+    Attributes
+    ----------
+    t : ndarray (n,)
+        Sample times (s): rate sample times, or increment interval end times.
+    data : ndarray (n, 3)
+        Rates (rad/s) or increments (rad).
+    kind : {"rate", "increment"}
+    h : float
+        Median sample interval (s).
+    gaps : list of int
+        Rows (1-based) whose interval exceeds the gap tolerance.
+    """
+
+    t: np.ndarray
+    data: np.ndarray
+    kind: str
+    h: float
+    gaps: list = field(default_factory=list)
+
+
+def _load_csv(path: Path, columns):
+    with open(path, newline="", encoding="utf-8") as f:
+        reader = csv.reader(f)
+        try:
+            header = [c.strip() for c in next(reader)]
+        except StopIteration:
+            raise ValueError(f"{path}: empty file") from None
+        missing = [c for c in columns if c not in header]
+        if missing:
+            raise ValueError(f"{path}: columns {missing} not in the header {header}; map them "
+                             "with --columns")
+        idx = [header.index(c) for c in columns]
+        text = f.read()
+    if not text.strip():
+        raise ValueError(f"{path}: no data rows")
+    try:
+        raw = np.loadtxt(_io.StringIO(text), delimiter=",", ndmin=2, dtype=np.float64)
+    except ValueError as exc:
+        raise ValueError(f"{path}: unreadable number ({exc})") from exc
+    if raw.shape[1] != len(header):
+        raise ValueError(f"{path}: rows have {raw.shape[1]} fields, the header {len(header)}")
+    return raw[:, idx]
+
+
+def _load(path: Path, columns, sample_rate_hz):
+    suffix = path.suffix.lower()
+    if suffix == ".csv":
+        arr = _load_csv(path, columns)
+        return arr[:, 0], arr[:, 1:4]
+    if suffix == ".npy":
+        arr = np.load(path, mmap_mode="r")
+        if arr.ndim != 2 or arr.shape[1] != 4:
+            raise ValueError(f"{path}: .npy logs must be (n, 4) [t, gx, gy, gz], got {arr.shape}")
+        return np.asarray(arr[:, 0], float), np.asarray(arr[:, 1:], float)
+    if suffix == ".npz":
+        with np.load(path) as z:
+            if "gyro" not in z or "t" not in z:
+                raise ValueError(f"{path}: .npz logs need arrays 't' and 'gyro'")
+            return np.asarray(z["t"], float), np.asarray(z["gyro"], float)
+    if suffix == ".mat":
+        from scipy.io import loadmat
+
+        m = loadmat(path)
+        if "imu_gyr" in m:  # BROAD
+            g = np.asarray(m["imu_gyr"], float)
+            fs = float(np.squeeze(m["sampling_rate"])) if "sampling_rate" in m else sample_rate_hz
+            if not fs:
+                raise ValueError(f"{path}: no sampling_rate; pass --sample-rate-hz")
+            return np.arange(g.shape[0]) / fs, g
+        for key in ("avp_imu", "imu", "wvt"):  # PSINS-style [wm vm t]
+            if key in m:
+                a = np.asarray(m[key], float)
+                if a.ndim != 2 or a.shape[1] < 7:
+                    raise ValueError(f"{path}: '{key}' must be [wm vm t] with ≥ 7 columns")
+                return a[:, -1], a[:, 0:3]
+        keys = [k for k in m if not k.startswith("__")]
+        raise ValueError(f"{path}: no 'imu_gyr' (BROAD) or 'imu' [wm vm t] (PSINS) variable; "
+                         f"found {keys}")
+    raise ValueError(f"{path}: unsupported format {suffix!r} (use .csv, .npy, .npz or .mat)")
+
+
+def read_imu(path, *, kind: str, units: str, columns=("t", "gx", "gy", "gz"),
+             sample_rate_hz: float | None = None, gap_tolerance: float = 1.5) -> ImuLog:
+    """Read and validate a gyro log (see the module docstring).
+
+    Parameters
+    ----------
+    kind : {"rate", "increment"}
+    units : {"rad/s", "deg/s"} for rates, {"rad", "deg"} for increments
+    columns : four CSV column names (time, x, y, z)
+    sample_rate_hz : float, optional
+        Required when the file carries no time (BROAD without sampling_rate).
+    gap_tolerance : float
+        Intervals longer than this many median intervals are reported as gaps.
+    """
+    path = Path(path)
+    if kind not in ("rate", "increment"):
+        raise ValueError(f"kind must be 'rate' or 'increment', got {kind!r}")
+    allowed = ("rad/s", "deg/s") if kind == "rate" else ("rad", "deg")
+    if units not in allowed:
+        raise ValueError(f"{kind} units must be one of {allowed}, got {units!r}")
+    if len(columns) != 4:
+        raise ValueError(f"columns must name time and three axes, got {columns}")
+    if not path.is_file():
+        raise ValueError(f"{path}: no such file")
+    t, g = _load(path, list(columns), sample_rate_hz)
+    if g.ndim != 2 or g.shape[1] != 3 or t.shape[0] != g.shape[0]:
+        raise ValueError(f"{path}: expected n times and (n, 3) gyro values, got {t.shape}, "
+                         f"{g.shape}")
+    if t.size < 2:
+        raise ValueError(f"{path}: {t.size} samples; at least 2 are needed")
+    bad = ~np.isfinite(t) | ~np.all(np.isfinite(g), axis=1)
+    if np.any(bad):
+        row = int(np.argmax(bad)) + 1
+        raise ValueError(f"{path}: NaN or infinity in data row {row}")
+    d = np.diff(t)
+    if np.any(d <= 0):
+        row = int(np.argmax(d <= 0)) + 2
+        what = "duplicated" if d[row - 2] == 0 else "non-monotonic"
+        raise ValueError(f"{path}: {what} time stamp in data row {row} (t = {t[row - 1]!r} "
+                         f"after {t[row - 2]!r})")
+    h = float(np.median(d))
+    gaps = [int(i) + 2 for i in np.flatnonzero(d > gap_tolerance * h)]
+    scale = _DEG if units.startswith("deg") else 1.0
+    g = g * scale
+    rate = g if kind == "rate" else g / h
+    big = float(np.percentile(np.linalg.norm(rate, axis=1), 99))
+    if not units.startswith("deg") and big > RATE_PLAUSIBLE_MAX:
+        warnings.warn(f"{path}: 99th-percentile rate {big:.0f} rad/s is implausible; the log is "
+                      f"more likely in degrees (declared {units})", UnitWarning, stacklevel=2)
+    if units.startswith("deg") and big < 1e-3 * _DEG and big > 0:
+        warnings.warn(f"{path}: 99th-percentile rate {big / _DEG:.2e} °/s is implausibly small; "
+                      f"the log is more likely in radians (declared {units})", UnitWarning,
+                      stacklevel=2)
+    return ImuLog(np.asarray(t, float), np.ascontiguousarray(g), kind, h, gaps)
+
+
+def write_attitude(path, t, q, *, extra: dict | None = None) -> Path:
+    """Write ``t, qw, qx, qy, qz`` (+ extra columns) atomically as CSV or ``.npz``."""
+    path = Path(path)
+    cols = {"t": np.asarray(t), "qw": q[:, 0], "qx": q[:, 1], "qy": q[:, 2], "qz": q[:, 3]}
+    cols.update(extra or {})
+    if path.suffix.lower() == ".npz":
+        with atomic_path(path) as tmp, open(tmp, "wb") as f:
+            np.savez(f, **cols)
+        return path
+    if path.suffix.lower() != ".csv":
+        raise ValueError(f"{path}: output must be .csv or .npz")
+    names = list(cols)
+    table = np.column_stack([np.asarray(cols[k], float) for k in names])
+    with atomic_path(path) as tmp:
+        np.savetxt(tmp, table, delimiter=",", header=",".join(names), comments="",
+                   fmt="%.17g")
+    return path

@@ -1,0 +1,139 @@
+"""Reading logs, validation with row numbers, unit plausibility, `strapdown run`."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.io import savemat
+
+from strapdown.cli import main
+from strapdown.coning import coefficient_set
+from strapdown.io import UnitWarning, read_imu
+from strapdown.motions import PureSpin, SpinConing
+from strapdown.structures import conventional, realtime
+
+BROAD = Path(__file__).resolve().parents[2] / "shared" / "data" / "broad"
+
+
+def _csv(path, t, g, names=("t", "gx", "gy", "gz")):
+    with open(path, "w") as f:
+        f.write(",".join(names) + "\n")
+        for ti, gi in zip(t, g, strict=True):
+            f.write(",".join(repr(float(v)) for v in (ti, *gi)) + "\n")
+
+
+def test_deg_per_s_declared_as_rad_per_s_warns(tmp_path):
+    t = np.arange(200) / 1000.0
+    w = PureSpin(math.radians(1080.0)).rate(t)
+    _csv(tmp_path / "log.csv", t, np.degrees(w))
+    with pytest.warns(UnitWarning, match="more likely in degrees"):
+        read_imu(tmp_path / "log.csv", kind="rate", units="rad/s")
+    log = read_imu(tmp_path / "log.csv", kind="rate", units="deg/s")
+    assert np.allclose(log.data, w, rtol=1e-14)
+
+
+def test_duplicated_timestamp_fails_with_row_and_writes_nothing(tmp_path, capsys):
+    t = np.arange(10) / 100.0
+    t[6] = t[5]
+    _csv(tmp_path / "log.csv", t, np.zeros((10, 3)))
+    out = tmp_path / "att.csv"
+    with pytest.raises(SystemExit) as exc:
+        main(["run", "--imu", str(tmp_path / "log.csv"), "--rates", "--units", "rad/s",
+              "--algorithm", "rk4", "--out", str(out)])
+    assert exc.value.code == 2
+    assert "duplicated time stamp in data row 7" in capsys.readouterr().err
+    assert not out.exists() and list(tmp_path.iterdir()) == [tmp_path / "log.csv"]
+
+
+@pytest.mark.parametrize(("mutate", "msg"), [
+    (lambda t, g: g.__setitem__((3, 1), np.nan), "NaN or infinity in data row 4"),
+    (lambda t, g: t.__setitem__(5, 0.001), "non-monotonic time stamp in data row 6"),
+])
+def test_validation_rows(tmp_path, mutate, msg):
+    t = np.arange(10) / 100.0
+    g = np.zeros((10, 3))
+    mutate(t, g)
+    _csv(tmp_path / "log.csv", t, g)
+    with pytest.raises(ValueError, match=msg):
+        read_imu(tmp_path / "log.csv", kind="rate", units="rad/s")
+
+
+def test_gaps_and_columns(tmp_path):
+    t = np.r_[np.arange(10), np.arange(20, 30)] / 100.0
+    _csv(tmp_path / "log.csv", t, np.zeros((20, 3)), names=("time", "a", "b", "c"))
+    with pytest.raises(ValueError, match="not in the header"):
+        read_imu(tmp_path / "log.csv", kind="rate", units="rad/s")
+    log = read_imu(tmp_path / "log.csv", kind="rate", units="rad/s",
+                   columns=("time", "a", "b", "c"))
+    assert log.gaps == [11]
+
+
+@pytest.mark.parametrize("structure", ["conventional", "realtime", "single-chain"])
+def test_run_npy_streams_and_matches_one_shot(tmp_path, structure, monkeypatch):
+    import strapdown.run as run_mod
+
+    monkeypatch.setattr(run_mod, "CHUNK", 777)  # many chunks
+    m = SpinConing(0.05, 2 * math.pi, 20.0)
+    h = 1e-3
+    n = 3000
+    edges = np.arange(n + 1) * h
+    th = m.increments(edges)
+    np.save(tmp_path / "log.npy", np.column_stack([edges[1:], th]))
+    main(["run", "--imu", str(tmp_path / "log.npy"), "--increments", "--units", "rad",
+          "--structure", structure, "--angles", "none", "--out", str(tmp_path / "a.csv")])
+    got = np.loadtxt(tmp_path / "a.csv", delimiter=",", skiprows=1)
+    cs = coefficient_set("table3", 3)
+    if structure == "conventional":
+        ref = conventional(th, cs, h=h)
+    elif structure == "realtime":
+        ref = realtime(th, cs, h=h)
+    else:
+        from strapdown.structures import single_chain
+
+        ref = single_chain(th, 3, h=h)
+    assert np.array_equal(got[:, 1:5], ref.q)
+    assert np.allclose(got[:, 0], ref.t, atol=1e-12)
+
+
+def test_run_refuses_to_overwrite_input(tmp_path, capsys):
+    np.save(tmp_path / "log.npy", np.zeros((5, 4)))
+    with pytest.raises(SystemExit):
+        main(["run", "--imu", str(tmp_path / "log.npy"), "--increments", "--units", "rad",
+              "--out", str(tmp_path / "log.npy")])
+    assert "must not be the input" in capsys.readouterr().err
+
+
+def test_psins_mat_layout(tmp_path):
+    n = 50
+    t = np.arange(1, n + 1) * 0.01
+    wm = np.tile([1e-4, 0, 0], (n, 1))
+    savemat(tmp_path / "imu.mat", {"imu": np.column_stack([wm, np.zeros((n, 3)), t])})
+    log = read_imu(tmp_path / "imu.mat", kind="increment", units="rad")
+    assert np.allclose(log.data, wm) and log.h == pytest.approx(0.01)
+
+
+@pytest.mark.skipif(not BROAD.is_dir(), reason="shared/data/broad is not beside the checkout")
+def test_broad_recording_reads_and_runs(tmp_path):
+    path = BROAD / "07_undisturbed_fast_rotation_B.mat"
+    log = read_imu(path, kind="rate", units="rad/s")
+    assert log.h == pytest.approx(1 / 285.714, rel=1e-3)
+    assert 5 < np.abs(log.data).max() < 40  # fast rotations, up to ~25 rad/s
+    main(["run", "--imu", str(path), "--rates", "--units", "rad/s", "--algorithm", "rk4",
+          "--angles", "none", "--out", str(tmp_path / "broad.npz")])
+    with np.load(tmp_path / "broad.npz") as z:
+        q = np.column_stack([z["qw"], z["qx"], z["qy"], z["qz"]])
+    assert np.allclose(np.linalg.norm(q, axis=1), 1.0, atol=1e-12)
+    with pytest.warns(UnitWarning):  # the same recording in deg/s, declared as rad/s
+        read_imu(_as_degrees(path, tmp_path), kind="rate", units="rad/s")
+
+
+def _as_degrees(path, tmp_path):
+    from scipy.io import loadmat
+
+    m = loadmat(path)
+    out = tmp_path / "deg.mat"
+    savemat(out, {"imu_gyr": np.degrees(m["imu_gyr"]), "sampling_rate": m["sampling_rate"]})
+    return out
