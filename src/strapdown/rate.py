@@ -36,7 +36,7 @@ import numpy as np
 from strapdown import _kernels
 from strapdown._validation import as_quaternions, finite_array
 from strapdown.coning import WindowedAlgorithm
-from strapdown.structures import AttitudeSolution, windowed
+from strapdown.structures import AttitudeSolution, _windowed
 
 __all__ = [
     "ALGORITHMS",
@@ -211,12 +211,12 @@ def rate_attitude(t, omega, *, algorithm: str, structure: str = "conventional",
         tt = rec.t[0] + np.arange(m + 1) * stride * rec.td
         return AttitudeSolution(tt, q, "rk4", None, rec.td, stride * rec.td,
                                 np.zeros(m + 1, int))
+    w = np.ascontiguousarray(rec.omega)  # validated once, by check_rate_record
     if algorithm == "rate-single":
-        return windowed(rec.omega, single_period_algorithm(coefficients), h=rec.td,
-                        t0=rec.t[0], q0=q0)
-    alg = three_period_algorithm(coefficients)
-    return windowed(rec.omega, alg, h=rec.td, t0=rec.t[0], q0=q0,
-                    sliding=structure == "sliding", startup=single_period_algorithm(coefficients))
+        return _windowed(w, single_period_algorithm(coefficients), rec.td, float(rec.t[0]), q0,
+                         False, None)
+    return _windowed(w, three_period_algorithm(coefficients), rec.td, float(rec.t[0]), q0,
+                     structure == "sliding", single_period_algorithm(coefficients))
 
 
 def _q0(q0):

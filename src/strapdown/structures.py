@@ -253,13 +253,17 @@ def windowed(samples, algorithm, *, h: float, t0: float = 0.0, q0=None,
     if not isinstance(algorithm, WindowedAlgorithm):
         raise ValueError(f"algorithm must be a WindowedAlgorithm, got {type(algorithm).__name__}")
     x, h, t0, q0 = _stream_inputs(samples, "samples", h, t0, q0)
+    return _windowed(np.ascontiguousarray(x), algorithm, h, t0, q0, sliding, startup)
+
+
+def _windowed(x, algorithm, h, t0, q0, sliding, startup) -> AttitudeSolution:
+    """:func:`windowed` on inputs already validated (C-contiguous float64, unit q0)."""
     b0 = algorithm.history
     last = x.shape[0] - 1 - algorithm.span  # largest admissible update start
     if last < b0:
         need = b0 + algorithm.span + 1
         raise ValueError(f"{algorithm.name!r} needs at least {need} samples, got {x.shape[0]}")
     u = algorithm.update
-    x = np.ascontiguousarray(x)
     if not sliding:
         starts = np.arange(b0, last + 1, u)
         q = np.empty((starts.size + 1, 4))
