@@ -14,6 +14,7 @@ __all__ = [
     "as_times",
     "as_vectors",
     "finite_array",
+    "first_bad_step",
     "positive",
     "positive_int",
 ]
@@ -68,14 +69,24 @@ def as_times(t, name: str = "t", *, min_len: int = 1) -> np.ndarray:
     if a.size < min_len:
         raise ValueError(f"{name} needs at least {min_len} samples, got {a.size}")
     if a.size > 1:
-        d = np.diff(a)
-        if np.any(d <= 0):
-            i = int(np.argmax(d <= 0))
+        fault = first_bad_step(np.diff(a))
+        if fault is not None:
+            i = fault[0]
             raise ValueError(
                 f"{name} must be strictly increasing: {name}[{i + 1}] = {a[i + 1]!r} "
                 f"does not exceed {name}[{i}] = {a[i]!r}"
             )
     return a
+
+
+def first_bad_step(d: np.ndarray) -> tuple[int, str] | None:
+    """First non-positive time step in ``d = diff(t)``: ``(i, "duplicated" | "non-monotonic")``,
+    so that ``t[i + 1]`` does not exceed ``t[i]``; ``None`` if ``t`` strictly increases."""
+    bad = d <= 0
+    if not np.any(bad):
+        return None
+    i = int(np.argmax(bad))
+    return i, "duplicated" if d[i] == 0 else "non-monotonic"
 
 
 def positive(x, name: str) -> float:

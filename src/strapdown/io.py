@@ -25,6 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from strapdown._io import atomic_path
+from strapdown._validation import first_bad_step
 
 __all__ = ["RATE_PLAUSIBLE_MAX", "ImuLog", "UnitWarning", "read_imu", "write_attitude"]
 
@@ -158,11 +159,11 @@ def read_imu(path, *, kind: str, units: str, columns=("t", "gx", "gy", "gz"),
         row = int(np.argmax(bad)) + 1
         raise ValueError(f"{path}: NaN or infinity in data row {row}")
     d = np.diff(t)
-    if np.any(d <= 0):
-        row = int(np.argmax(d <= 0)) + 2
-        what = "duplicated" if d[row - 2] == 0 else "non-monotonic"
-        raise ValueError(f"{path}: {what} time stamp in data row {row} (t = {t[row - 1]!r} "
-                         f"after {t[row - 2]!r})")
+    fault = first_bad_step(d)
+    if fault is not None:
+        i, what = fault
+        raise ValueError(f"{path}: {what} time stamp in data row {i + 2} (t = {t[i + 1]!r} "
+                         f"after {t[i]!r})")
     h = float(np.median(d))
     gaps = [int(i) + 2 for i in np.flatnonzero(d > gap_tolerance * h)]
     scale = _DEG if units.startswith("deg") else 1.0

@@ -34,7 +34,7 @@ from fractions import Fraction
 import numpy as np
 
 from strapdown import _kernels
-from strapdown._validation import as_quaternions, finite_array
+from strapdown._validation import as_quaternions, finite_array, first_bad_step
 from strapdown.coning import WindowedAlgorithm
 from strapdown.structures import AttitudeSolution, _windowed
 
@@ -96,11 +96,11 @@ def check_rate_record(t, omega, *, min_samples: int = 2) -> RateRecord:
         raise ValueError(f"the record has {t.size} samples; this algorithm needs at least "
                          f"{min_samples}")
     d = np.diff(t)
-    if np.any(d <= 0):
-        row = int(np.argmax(d <= 0)) + 1
-        kind = "duplicated" if d[row - 1] == 0 else "non-monotonic"
-        raise ValueError(f"{kind} time stamp at row {row}: t[{row}] = {t[row]!r} after "
-                         f"t[{row - 1}] = {t[row - 1]!r}")
+    fault = first_bad_step(d)
+    if fault is not None:
+        i, kind = fault
+        raise ValueError(f"{kind} time stamp at row {i + 1}: t[{i + 1}] = {t[i + 1]!r} after "
+                         f"t[{i}] = {t[i]!r}")
     td = float((t[-1] - t[0]) / (t.size - 1))  # nominal interval: O(n), no sort
     if np.any(np.abs(d - td) > UNIFORM_TOLERANCE * td):
         # something is off: locate it against the robust (median) interval

@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from strapdown._io import atomic_path
+from strapdown._validation import first_bad_step
 from strapdown.coning import coefficient_set
 from strapdown.io import read_imu
 from strapdown.rotation.cone_angles import cone_angles_from_quat
@@ -62,11 +63,10 @@ def _npy_chunks(path: Path, units: str):
         if np.any(bad):
             raise ValueError(f"{path}: NaN or infinity in data row {s + int(np.argmax(bad)) + 1}")
         t = c[:, 0] if last is None else np.concatenate([[last], c[:, 0]])
-        d = np.diff(t)
-        if np.any(d <= 0):
-            i = int(np.argmax(d <= 0))
+        fault = first_bad_step(np.diff(t))
+        if fault is not None:
+            i, what = fault
             row = s + i + (1 if last is None else 0) + 1
-            what = "duplicated" if d[i] == 0 else "non-monotonic"
             raise ValueError(f"{path}: {what} time stamp in data row {row}")
         last = c[-1, 0]
         yield c[:, 0], c[:, 1:] * scale
