@@ -18,6 +18,7 @@ What we measure (papers.md, seed 000):
 
 from __future__ import annotations
 
+import functools
 import math
 import time
 from collections.abc import Callable
@@ -71,9 +72,13 @@ def _omega_h(spp: int) -> float:
     return 2.0 * math.pi / spp
 
 
+@functools.lru_cache(maxsize=512)
 def drift_mp(a: float, spp: int, n: int, structure: str, coefficients: str = "table3",
              periods: int = 2, digits: int = DIGITS) -> float:
-    """Cone-axis drift (rad/s) in arbitrary precision, mean over interleaved chains."""
+    """Cone-axis drift (rad/s) in arbitrary precision, mean over interleaved chains.
+
+    Memoised: the report's tables ask for the same configurations more than once.
+    """
     motion = ClassicalConing(a, OMEGA)
     h = motion.period / spp
     cs = coefficient_set(coefficients, n)
@@ -84,6 +89,7 @@ def drift_mp(a: float, spp: int, n: int, structure: str, coefficients: str = "ta
     return float(np.mean([c.rate for c in chains]))
 
 
+@functools.lru_cache(maxsize=64)
 def drift_f64(a: float, spp: int, n: int, structure: str, periods: int = 20) -> float:
     """Cone-axis drift (rad/s) in float64 (same pipeline as ``strapdown evaluate``)."""
     motion = ClassicalConing(a, OMEGA)
