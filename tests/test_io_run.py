@@ -13,6 +13,7 @@ from strapdown.cli import main
 from strapdown.coning import coefficient_set
 from strapdown.io import UnitWarning, read_imu
 from strapdown.motions import PureSpin, SpinConing
+from strapdown.run import run_log
 from strapdown.structures import conventional, realtime
 
 BROAD = Path(__file__).resolve().parents[2] / "shared" / "data" / "broad"
@@ -137,3 +138,84 @@ def _as_degrees(path, tmp_path):
     out = tmp_path / "deg.mat"
     savemat(out, {"imu_gyr": np.degrees(m["imu_gyr"]), "sampling_rate": m["sampling_rate"]})
     return out
+
+
+def test_header_declares_units_and_contradiction_fails(tmp_path):
+    t = np.arange(50) / 100.0
+    w = np.tile([0.5, -0.25, 0.125], (50, 1))
+    _csv(tmp_path / "log.csv", t, np.degrees(w),
+         names=("t[s]", "gx[deg/s]", "gy[deg/s]", "gz[deg/s]"))
+    log = read_imu(tmp_path / "log.csv", kind="rate", units=None)
+    assert np.allclose(log.data, w, rtol=1e-14)
+    with pytest.raises(ValueError, match="contradict the header's 'deg/s'"):
+        read_imu(tmp_path / "log.csv", kind="rate", units="rad/s")
+    with pytest.raises(ValueError, match="a increment log needs one of"):
+        read_imu(tmp_path / "log.csv", kind="increment", units=None)
+    _csv(tmp_path / "plain.csv", t, w)
+    with pytest.raises(ValueError, match="no units declared"):
+        read_imu(tmp_path / "plain.csv", kind="rate", units=None)
+
+
+def test_gap_policy_and_segments(tmp_path):
+    t = np.r_[np.arange(10), np.arange(20, 30)] / 100.0
+    _csv(tmp_path / "log.csv", t, np.zeros((20, 3)))
+    with pytest.raises(ValueError, match=r"gap of 0\.11 s .* before data row 11"):
+        read_imu(tmp_path / "log.csv", kind="rate", units="rad/s", on_gap="error")
+    log = read_imu(tmp_path / "log.csv", kind="rate", units="rad/s")
+    assert [(s.start, s.stop) for s in log.segments()] == [(0, 10), (10, 20)]
+
+
+def test_run_split_at_gap_restarts_integration(tmp_path):
+    # constant rate about x, 1 rad/s; a 0.1 s gap in the log. Split: each segment integrates
+    # only its own samples, so the angle at the end is 18 samples × 0.01 s (not 0.29 s).
+    t = np.r_[np.arange(10), np.arange(20, 30)] / 100.0
+    _csv(tmp_path / "log.csv", t, np.tile([1.0, 0, 0], (20, 1)))
+    out = tmp_path / "att.csv"
+    main(["run", "--imu", str(tmp_path / "log.csv"), "--rates", "--units", "rad/s",
+          "--algorithm", "rate-single", "--on-gap", "split", "--angles", "none",
+          "--out", str(out)])
+    a = np.genfromtxt(out, delimiter=",", names=True)
+    assert set(a["segment"]) == {0.0, 1.0}
+    angle = 2 * np.arctan2(a["qx"][-1], a["qw"][-1])
+    assert angle == pytest.approx(0.18, rel=1e-12)
+    # without splitting, rate algorithms refuse the non-uniform record and write nothing
+    with pytest.raises(ValueError, match="between samples 10 and 11"):
+        run_log(tmp_path / "log.csv", tmp_path / "b.csv", kind="rate", units="rad/s",
+                algorithm="rate-single")
+    assert not (tmp_path / "b.csv").exists()
+
+
+def test_saturation_is_reported(tmp_path, capsys):
+    t = np.arange(30) / 100.0
+    g = np.zeros((30, 3))
+    g[[4, 17], 2] = 2000.0
+    _csv(tmp_path / "log.csv", t, g)
+    log = read_imu(tmp_path / "log.csv", kind="rate", units="deg/s", saturation=2000.0)
+    assert log.saturated == [5, 18]
+    main(["run", "--imu", str(tmp_path / "log.csv"), "--rates", "--units", "deg/s",
+          "--algorithm", "rk4", "--saturation", "2000", "--out", str(tmp_path / "o.csv")])
+    assert "2 saturated row(s), first at data row 5" in capsys.readouterr().err
+
+
+def test_hdf5_log(tmp_path):
+    h5py = pytest.importorskip("h5py")
+    t = np.arange(100) / 200.0
+    w = SpinConing(0.05, 2 * math.pi, 20.0).rate(t)
+    with h5py.File(tmp_path / "log.h5", "w") as f:
+        f["t"] = t
+        f["gyro"] = w
+    log = read_imu(tmp_path / "log.h5", kind="rate", units="rad/s")
+    assert np.array_equal(log.data, w) and np.array_equal(log.t, t)
+    with h5py.File(tmp_path / "bad.h5", "w") as f:
+        f["acc"] = w
+    with pytest.raises(ValueError, match="datasets 't' and 'gyro'"):
+        read_imu(tmp_path / "bad.h5", kind="rate", units="rad/s")
+
+
+def test_run_progress_bar_goes_to_stderr(tmp_path, capsys):
+    np.save(tmp_path / "log.npy", np.column_stack([np.arange(1, 301) * 1e-3,
+                                                   np.full((300, 3), 1e-4)]))
+    main(["run", "--imu", str(tmp_path / "log.npy"), "--increments", "--units", "rad",
+          "--progress", "--out", str(tmp_path / "a.csv")])
+    cap = capsys.readouterr()
+    assert "300/300" in cap.err and "wrote" in cap.out

@@ -123,7 +123,7 @@ Z4 = np.zeros((4, 3))
         (np.array([0.0, 0.1, 0.1, 0.3]), Z4, {}, "duplicated time stamp at row 2"),
         (np.array([0.0, 0.1, 0.05, 0.3]), Z4, {}, "non-monotonic time stamp at row 2"),
         (np.array([0.0, 0.1, 0.2, 0.35, 0.45]), np.zeros((5, 3)), {},
-         "non-uniform sampling at row 3"),
+         "non-uniform sampling between samples 3 and 4"),
         (np.arange(4) * 0.1, np.array([[0, 0, 0], [0, np.nan, 0], [0, 0, 0], [0, 0, 0]]), {},
          "NaN or infinity at row 1"),
         (np.arange(3) * 0.1, np.zeros((3, 3)), {}, "needs at least 4"),

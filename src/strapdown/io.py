@@ -2,22 +2,30 @@
 
 Formats (by suffix): CSV with a header row (columns mapped by name, default
 ``t,gx,gy,gz``), NumPy ``.npy`` (``(n, 4)`` ``[t, gx, gy, gz]``) and ``.npz``
-(arrays ``t`` and ``gyro``), MATLAB ``.mat`` (PSINS ``[wm vm t]`` — increments
-in columns 1–3, time last — or BROAD ``imu_gyr`` with ``sampling_rate``).
+(arrays ``t`` and ``gyro``), HDF5 ``.h5``/``.hdf5`` (datasets ``t`` and
+``gyro``, or BROAD's ``imu_gyr`` with a ``sampling_rate``; needs the ``hdf5``
+extra), MATLAB ``.mat`` (PSINS ``[wm vm t]`` — increments in columns 1–3, time
+last — or BROAD ``imu_gyr`` with ``sampling_rate``).
 
 Every log declares what it holds: rates or increments, and the unit
-(``rad/s``/``deg/s`` for rates, ``rad``/``deg`` for increments). A plausibility
-check warns when magnitudes suggest the other unit (a rate above
-:data:`RATE_PLAUSIBLE_MAX` rad/s declared as rad/s is more likely deg/s).
-Validation raises on NaN or infinity, duplicated or non-monotonic time stamps
-(with the row number, counting the first data row as 1) and reports gaps
-larger than ``gap_tolerance`` sample intervals.
+(``rad/s``/``deg/s`` for rates, ``rad``/``deg`` for increments), either by
+argument or — for CSV — by the header convention ``gx[deg/s]`` (a unit in
+brackets after a column name; a declared unit that contradicts the header is
+an error). A plausibility check warns when magnitudes suggest the other unit
+(a rate above :data:`RATE_PLAUSIBLE_MAX` rad/s declared as rad/s is more likely
+deg/s). Validation raises on NaN or infinity, duplicated or non-monotonic time
+stamps (with the row number, counting the first data row as 1), reports gaps
+larger than ``gap_tolerance`` sample intervals (or raises, ``on_gap="error"``;
+:meth:`ImuLog.segments` splits at them) and reports rows at or above a
+declared saturation level.
 """
 
 from __future__ import annotations
 
 import csv
 import io as _io
+import itertools
+import re
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -54,6 +62,8 @@ class ImuLog:
         Median sample interval (s).
     gaps : list of int
         Rows (1-based) whose interval exceeds the gap tolerance.
+    saturated : list of int
+        Rows (1-based) with a component at or above the declared saturation.
     """
 
     t: np.ndarray
@@ -61,13 +71,38 @@ class ImuLog:
     kind: str
     h: float
     gaps: list = field(default_factory=list)
+    saturated: list = field(default_factory=list)
+
+    def segments(self) -> list[slice]:
+        """Index ranges between gaps: each a gap-free run of samples.
+
+        A gap reported at data row ``r`` (1-based) starts a new segment at index ``r − 1``.
+        """
+        edges = [0, *(r - 1 for r in self.gaps), self.t.size]
+        return [slice(a, b) for a, b in itertools.pairwise(edges)]
+
+
+_UNIT = re.compile(r"^\s*([^\[\]]*?)\s*\[\s*([^\[\]]+?)\s*\]\s*$")
+
+
+def _split_header(cells):
+    """Column names and the units the header declares (``gx[deg/s]`` → ``gx``, ``deg/s``)."""
+    names, units = [], {}
+    for c in cells:
+        m = _UNIT.match(c)
+        if m:
+            names.append(m.group(1))
+            units[m.group(1)] = m.group(2)
+        else:
+            names.append(c.strip())
+    return names, units
 
 
 def _load_csv(path: Path, columns):
     with open(path, newline="", encoding="utf-8") as f:
         reader = csv.reader(f)
         try:
-            header = [c.strip() for c in next(reader)]
+            header, units = _split_header(next(reader))
         except StopIteration:
             raise ValueError(f"{path}: empty file") from None
         missing = [c for c in columns if c not in header]
@@ -84,24 +119,52 @@ def _load_csv(path: Path, columns):
         raise ValueError(f"{path}: unreadable number ({exc})") from exc
     if raw.shape[1] != len(header):
         raise ValueError(f"{path}: rows have {raw.shape[1]} fields, the header {len(header)}")
-    return raw[:, idx]
+    axis_units = {units[c] for c in columns[1:] if c in units}
+    if len(axis_units) > 1:
+        raise ValueError(f"{path}: the header gives the axes different units {sorted(axis_units)}")
+    return raw[:, idx], (axis_units.pop() if axis_units else None)
+
+
+def _load_hdf5(path: Path, sample_rate_hz):
+    try:
+        import h5py
+    except ImportError:
+        raise ValueError(f"{path}: reading HDF5 needs h5py: pip install 'strapdown[hdf5]'"
+                         ) from None
+    with h5py.File(path, "r") as f:
+        if "gyro" in f and "t" in f:
+            return np.asarray(f["t"], float), np.asarray(f["gyro"], float)
+        if "imu_gyr" in f:
+            g = np.asarray(f["imu_gyr"], float)
+            fs = f.attrs.get("sampling_rate", None)
+            if fs is None and "sampling_rate" in f:
+                fs = np.asarray(f["sampling_rate"])
+            fs = float(np.squeeze(fs)) if fs is not None else sample_rate_hz
+            if not fs:
+                raise ValueError(f"{path}: no sampling_rate; pass --sample-rate-hz")
+            return np.arange(g.shape[0]) / fs, g
+        raise ValueError(f"{path}: HDF5 logs need datasets 't' and 'gyro' (or BROAD's "
+                         f"'imu_gyr'); found {sorted(f.keys())}")
 
 
 def _load(path: Path, columns, sample_rate_hz):
+    """``(t, gyro, header_units)`` from any supported file."""
     suffix = path.suffix.lower()
     if suffix == ".csv":
-        arr = _load_csv(path, columns)
-        return arr[:, 0], arr[:, 1:4]
+        arr, units = _load_csv(path, columns)
+        return arr[:, 0], arr[:, 1:4], units
+    if suffix in (".h5", ".hdf5"):
+        return (*_load_hdf5(path, sample_rate_hz), None)
     if suffix == ".npy":
         arr = np.load(path, mmap_mode="r")
         if arr.ndim != 2 or arr.shape[1] != 4:
             raise ValueError(f"{path}: .npy logs must be (n, 4) [t, gx, gy, gz], got {arr.shape}")
-        return np.asarray(arr[:, 0], float), np.asarray(arr[:, 1:], float)
+        return np.asarray(arr[:, 0], float), np.asarray(arr[:, 1:], float), None
     if suffix == ".npz":
         with np.load(path) as z:
             if "gyro" not in z or "t" not in z:
                 raise ValueError(f"{path}: .npz logs need arrays 't' and 'gyro'")
-            return np.asarray(z["t"], float), np.asarray(z["gyro"], float)
+            return np.asarray(z["t"], float), np.asarray(z["gyro"], float), None
     if suffix == ".mat":
         from scipy.io import loadmat
 
@@ -111,44 +174,72 @@ def _load(path: Path, columns, sample_rate_hz):
             fs = float(np.squeeze(m["sampling_rate"])) if "sampling_rate" in m else sample_rate_hz
             if not fs:
                 raise ValueError(f"{path}: no sampling_rate; pass --sample-rate-hz")
-            return np.arange(g.shape[0]) / fs, g
+            return np.arange(g.shape[0]) / fs, g, None
         for key in ("avp_imu", "imu", "wvt"):  # PSINS-style [wm vm t]
             if key in m:
                 a = np.asarray(m[key], float)
                 if a.ndim != 2 or a.shape[1] < 7:
                     raise ValueError(f"{path}: '{key}' must be [wm vm t] with ≥ 7 columns")
-                return a[:, -1], a[:, 0:3]
+                return a[:, -1], a[:, 0:3], None
         keys = [k for k in m if not k.startswith("__")]
         raise ValueError(f"{path}: no 'imu_gyr' (BROAD) or 'imu' [wm vm t] (PSINS) variable; "
                          f"found {keys}")
-    raise ValueError(f"{path}: unsupported format {suffix!r} (use .csv, .npy, .npz or .mat)")
+    raise ValueError(f"{path}: unsupported format {suffix!r} (use .csv, .npy, .npz, .h5 or "
+                     ".mat)")
 
 
-def read_imu(path, *, kind: str, units: str, columns=("t", "gx", "gy", "gz"),
-             sample_rate_hz: float | None = None, gap_tolerance: float = 1.5) -> ImuLog:
+def read_imu(path, *, kind: str, units: str | None, columns=("t", "gx", "gy", "gz"),
+             sample_rate_hz: float | None = None, gap_tolerance: float = 1.5,
+             on_gap: str = "report", saturation: float | None = None) -> ImuLog:
     """Read and validate a gyro log (see the module docstring).
 
     Parameters
     ----------
     kind : {"rate", "increment"}
-    units : {"rad/s", "deg/s"} for rates, {"rad", "deg"} for increments
+    units : {"rad/s", "deg/s"} for rates, {"rad", "deg"} for increments, or None
+        None takes the unit from a CSV header (``gx[deg/s]``); it is an error
+        when the file declares none.
     columns : four CSV column names (time, x, y, z)
     sample_rate_hz : float, optional
         Required when the file carries no time (BROAD without sampling_rate).
     gap_tolerance : float
-        Intervals longer than this many median intervals are reported as gaps.
+        Intervals longer than this many median intervals are gaps.
+    on_gap : {"report", "error"}
+        Report gaps in :attr:`ImuLog.gaps` (split with :meth:`ImuLog.segments`)
+        or raise at the first.
+    saturation : float, optional
+        Sensor range in the declared unit (per axis); rows with a component at
+        or above it are listed in :attr:`ImuLog.saturated`.
     """
     path = Path(path)
     if kind not in ("rate", "increment"):
         raise ValueError(f"kind must be 'rate' or 'increment', got {kind!r}")
     allowed = ("rad/s", "deg/s") if kind == "rate" else ("rad", "deg")
-    if units not in allowed:
+    if units is not None and units not in allowed:
         raise ValueError(f"{kind} units must be one of {allowed}, got {units!r}")
+    if on_gap not in ("report", "error"):
+        raise ValueError(f"on_gap must be 'report' or 'error', got {on_gap!r}")
+    if not gap_tolerance > 1:
+        raise ValueError(f"gap_tolerance is in sample intervals and must exceed 1, got "
+                         f"{gap_tolerance}")
+    if saturation is not None and not saturation > 0:
+        raise ValueError(f"saturation must be positive, got {saturation}")
     if len(columns) != 4:
         raise ValueError(f"columns must name time and three axes, got {columns}")
     if not path.is_file():
         raise ValueError(f"{path}: no such file")
-    t, g = _load(path, list(columns), sample_rate_hz)
+    t, g, header_units = _load(path, list(columns), sample_rate_hz)
+    if header_units is not None:
+        if header_units not in allowed:
+            raise ValueError(f"{path}: the header declares {header_units!r}; a {kind} log "
+                             f"needs one of {allowed}")
+        if units is not None and units != header_units:
+            raise ValueError(f"{path}: declared units {units!r} contradict the header's "
+                             f"{header_units!r}")
+        units = header_units
+    if units is None:
+        raise ValueError(f"{path}: no units declared; pass --units or write them in the header "
+                         f"(e.g. gx[{allowed[0]}])")
     if g.ndim != 2 or g.shape[1] != 3 or t.shape[0] != g.shape[0]:
         raise ValueError(f"{path}: expected n times and (n, 3) gyro values, got {t.shape}, "
                          f"{g.shape}")
@@ -166,6 +257,13 @@ def read_imu(path, *, kind: str, units: str, columns=("t", "gx", "gy", "gz"),
                          f"after {t[i]!r})")
     h = float(np.median(d))
     gaps = [int(i) + 2 for i in np.flatnonzero(d > gap_tolerance * h)]
+    if gaps and on_gap == "error":
+        r = gaps[0]
+        raise ValueError(f"{path}: gap of {d[r - 2]:.6g} s ({d[r - 2] / h:.1f} sample intervals) "
+                         f"before data row {r}")
+    saturated = []
+    if saturation is not None:
+        saturated = [int(i) + 1 for i in np.flatnonzero(np.any(np.abs(g) >= saturation, axis=1))]
     scale = _DEG if units.startswith("deg") else 1.0
     g = g * scale
     rate = g if kind == "rate" else g / h
@@ -177,7 +275,7 @@ def read_imu(path, *, kind: str, units: str, columns=("t", "gx", "gy", "gz"),
         warnings.warn(f"{path}: 99th-percentile rate {big / _DEG:.2e} °/s is implausibly small; "
                       f"the log is more likely in radians (declared {units})", UnitWarning,
                       stacklevel=2)
-    return ImuLog(np.asarray(t, float), np.ascontiguousarray(g), kind, h, gaps)
+    return ImuLog(np.asarray(t, float), np.ascontiguousarray(g), kind, h, gaps, saturated)
 
 
 def write_attitude(path, t, q, *, extra: dict | None = None) -> Path:

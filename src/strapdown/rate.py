@@ -108,9 +108,10 @@ def check_rate_record(t, omega, *, min_samples: int = 2) -> RateRecord:
         off = np.abs(d - med) > UNIFORM_TOLERANCE * med
         if np.any(off):
             row = int(np.argmax(off)) + 1
-            raise ValueError(f"non-uniform sampling at row {row}: interval {d[row - 1]!r} s "
-                             f"against the median {med!r} s (tolerance "
-                             f"{UNIFORM_TOLERANCE:g} relative)")
+            raise ValueError(f"non-uniform sampling between samples {row} and {row + 1}: "
+                             f"interval {float(d[row - 1]):.9g} s against the median "
+                             f"{float(med):.9g} s (tolerance {UNIFORM_TOLERANCE:g} relative); "
+                             "rate algorithms need uniform samples — split logs at gaps")
         td = med
     return RateRecord(t, w, td)
 

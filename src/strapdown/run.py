@@ -10,10 +10,12 @@ the input file is never overwritten.
 
 from __future__ import annotations
 
+import sys
 import warnings
 from pathlib import Path
 
 import numpy as np
+from tqdm import tqdm
 
 from strapdown._io import atomic_path
 from strapdown._validation import first_bad_step
@@ -72,11 +74,24 @@ def _npy_chunks(path: Path, units: str):
         yield c[:, 0], c[:, 1:] * scale
 
 
-def run_log(imu, out, *, kind: str, units: str, algorithm: str = "rotvec",
+def run_log(imu, out, *, kind: str, units: str | None, algorithm: str = "rotvec",
             structure: str = "conventional", subsamples: int = 3, coefficients=None,
             columns=("t", "gx", "gy", "gz"), sample_rate_hz=None, angles: str = "ypr",
-            q0=None) -> dict:
-    """Process a log; returns a summary (samples, outputs, gaps, warnings)."""
+            q0=None, on_gap: str = "report", gap_tolerance: float = 1.5,
+            saturation: float | None = None, progress: bool = False) -> dict:
+    """Process a log; returns a summary (samples, outputs, gaps, saturated rows, warnings).
+
+    Parameters
+    ----------
+    on_gap : {"report", "error", "split"}
+        ``split`` runs each gap-free segment separately (each starting from the
+        previous segment's last attitude, no increment or rate spanning the gap)
+        and adds a ``segment`` column.
+    saturation : float, optional
+        Sensor range in the declared unit; saturated rows are reported.
+    progress : bool
+        Show a progress bar (tqdm, on stderr).
+    """
     imu, out = Path(imu), Path(out)
     if out.resolve() == imu.resolve():
         raise ValueError("--out must not be the input file")
@@ -84,65 +99,101 @@ def run_log(imu, out, *, kind: str, units: str, algorithm: str = "rotvec",
         raise ValueError(f"{out}: output must be .csv or .npz")
     if angles not in ("ypr", "cone", "none"):
         raise ValueError(f"angles must be ypr, cone or none, got {angles!r}")
+    if on_gap not in ("report", "error", "split"):
+        raise ValueError(f"on_gap must be report, error or split, got {on_gap!r}")
+    if algorithm == "rotvec" and kind != "increment":
+        raise ValueError("rotvec takes increments (--increments); for rate logs use "
+                         "rate-single, rate-three or rk4")
+    if algorithm != "rotvec" and kind != "rate":
+        raise ValueError(f"{algorithm} takes rate samples (--rates)")
+    read = {"kind": kind, "units": units, "columns": columns, "sample_rate_hz": sample_rate_hz,
+            "gap_tolerance": gap_tolerance, "on_gap": "error" if on_gap == "error" else "report",
+            "saturation": saturation}
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         if algorithm != "rotvec":
-            return _run_rates(imu, out, kind, units, algorithm, structure, coefficients,
-                              columns, sample_rate_hz, angles, q0, caught)
-        if kind != "increment":
-            raise ValueError("rotvec takes increments (--increments); for rate logs use "
-                             "rate-single, rate-three or rk4")
-        cs = coefficient_set(coefficients or "table3", subsamples)
-        if imu.suffix.lower() == ".npy":
-            chunks = _npy_chunks(imu, units)
-            gaps: list = []
+            res = _run_rates(imu, out, read, algorithm, structure, coefficients, angles, q0,
+                             on_gap == "split")
         else:
-            log = read_imu(imu, kind="increment", units=units, columns=columns,
-                           sample_rate_hz=sample_rate_hz)
-            gaps = log.gaps
-            chunks = ((log.t[s:s + CHUNK], log.data[s:s + CHUNK])
-                      for s in range(0, log.t.size, CHUNK))
-        stream = None
-        n_in = n_out = 0
-        with atomic_path(out) as tmp:
-            parts = []
-            with open(tmp, "w", encoding="utf-8") as f:
-                if out.suffix.lower() == ".csv":
-                    f.write(_header(angles) + "\n")
+            res = _run_increments(imu, out, read, structure, coefficient_set(
+                coefficients or "table3", subsamples), angles, q0, on_gap == "split", progress)
+    res["warnings"] = [str(w.message) for w in caught]
+    return res
+
+
+def _run_increments(imu, out, read, structure, cs, angles, q0, split, progress):
+    if imu.suffix.lower() == ".npy" and not split:
+        if read["units"] is None:
+            raise ValueError(f"{imu}: .npy logs carry no units; pass --units")
+        total = np.load(imu, mmap_mode="r").shape[0]
+        segments = [_npy_chunks(imu, read["units"])]
+        gaps: list = []
+        saturated: list = []
+        h_log = 1.0
+    else:
+        log = read_imu(imu, **read)
+        total, gaps, saturated, h_log = log.t.size, log.gaps, log.saturated, log.h
+        cuts = log.segments() if split else [slice(0, log.t.size)]
+        segments = [((log.t[c][s:s + CHUNK], log.data[c][s:s + CHUNK])
+                     for s in range(0, c.stop - c.start, CHUNK)) for c in cuts]
+    csv_out = out.suffix.lower() == ".csv"
+    names = _header(angles).split(",") + (["segment"] if split else [])
+    n_in = n_out = 0
+    q_last = q0
+    with atomic_path(out) as tmp, tqdm(total=total, disable=not progress, unit="sample",
+                                       unit_scale=True, file=sys.stderr) as bar:
+        parts = []
+        with open(tmp, "w", encoding="utf-8") as f:
+            if csv_out:
+                f.write(",".join(names) + "\n")
+            for k, chunks in enumerate(segments):
+                stream = None
                 for t, th in chunks:
                     if stream is None:
-                        h = float(t[1] - t[0]) if t.size > 1 else 1.0
-                        stream = RotvecStream(structure, cs, h=h, t0=float(t[0]) - h, q0=q0)
+                        h = float(t[1] - t[0]) if t.size > 1 else h_log
+                        stream = RotvecStream(structure, cs, h=h, t0=float(t[0]) - h, q0=q_last)
                     res = stream.feed(th)
                     n_in += th.shape[0]
+                    bar.update(th.shape[0])
                     if res.q.shape[0]:
                         rows = _rows(res.t, res.q, angles)
+                        if split:
+                            rows = np.column_stack([rows, np.full(rows.shape[0], float(k))])
                         n_out += rows.shape[0]
-                        if out.suffix.lower() == ".csv":
+                        if csv_out:
                             np.savetxt(f, rows, delimiter=",", fmt="%.17g")
                         else:
                             parts.append(rows)
-            if stream is None:
-                raise ValueError(f"{imu}: no samples")
-            if out.suffix.lower() == ".npz":
-                table = np.concatenate(parts) if parts else np.empty((0, 5))
-                names = _header(angles).split(",")
-                with open(tmp, "wb") as f:
-                    np.savez(f, **{k: table[:, i] for i, k in enumerate(names)})
-    return {"samples": n_in, "outputs": n_out, "gaps": gaps,
-            "warnings": [str(w.message) for w in caught]}
+                        q_last = res.q[-1]
+        if n_in == 0:
+            raise ValueError(f"{imu}: no samples")
+        if not csv_out:
+            table = np.concatenate(parts) if parts else np.empty((0, len(names)))
+            with open(tmp, "wb") as f:
+                np.savez(f, **{k: table[:, i] for i, k in enumerate(names)})
+    return {"samples": n_in, "outputs": n_out, "gaps": gaps, "saturated": saturated}
 
 
-def _run_rates(imu, out, kind, units, algorithm, structure, coefficients, columns,
-               sample_rate_hz, angles, q0, caught):
+def _run_rates(imu, out, read, algorithm, structure, coefficients, angles, q0, split):
     from strapdown import rate
     from strapdown.io import write_attitude
 
-    if kind != "rate":
-        raise ValueError(f"{algorithm} takes rate samples (--rates)")
-    log = read_imu(imu, kind="rate", units=units, columns=columns, sample_rate_hz=sample_rate_hz)
-    sol = rate.rate_attitude(log.t, log.data, algorithm=algorithm, structure=structure,
-                             coefficients=coefficients or "derived", q0=q0)
-    write_attitude(out, sol.t, sol.q, extra=_angles(sol.q, angles))
-    return {"samples": int(log.t.size), "outputs": int(sol.t.size), "gaps": log.gaps,
-            "warnings": [str(w.message) for w in caught]}
+    log = read_imu(imu, **read)
+    cuts = log.segments() if split else [slice(0, log.t.size)]
+    ts, qs, segs = [], [], []
+    q_last = q0
+    for k, c in enumerate(cuts):
+        sol = rate.rate_attitude(log.t[c], log.data[c], algorithm=algorithm,
+                                 structure=structure, coefficients=coefficients or "derived",
+                                 q0=q_last)
+        ts.append(sol.t)
+        qs.append(sol.q)
+        segs.append(np.full(sol.t.size, float(k)))
+        q_last = sol.q[-1]
+    t, q = np.concatenate(ts), np.concatenate(qs)
+    extra = _angles(q, angles)
+    if split:
+        extra["segment"] = np.concatenate(segs)
+    write_attitude(out, t, q, extra=extra)
+    return {"samples": int(log.t.size), "outputs": int(t.size), "gaps": log.gaps,
+            "saturated": log.saturated}

@@ -29,11 +29,11 @@ import numpy as np
 
 from strapdown import analysis, sensors
 from strapdown._io import markdown_table, write_text
+from strapdown._report import ReportWriter, begin_report
 from strapdown.analysis import sawtooth_amplitude
 from strapdown.coning import TABLE3, coefficient_set, table1_drift_constant
 from strapdown.motions import ClassicalConing
 from strapdown.precision import run_mp
-from strapdown.reproduce._report import ReportWriter, begin_report
 from strapdown.structures import run_structure
 
 F = Fraction

@@ -26,6 +26,7 @@ import numpy as np
 
 from strapdown import analysis
 from strapdown._io import write_text
+from strapdown._report import begin_report
 from strapdown.motions import ClassicalConing, KrylovMotion, Motion
 from strapdown.optimize import optimize
 from strapdown.quaternion_algorithms import (
@@ -35,7 +36,6 @@ from strapdown.quaternion_algorithms import (
     quaternion_attitude,
     subintervals,
 )
-from strapdown.reproduce._report import begin_report
 
 K = (0.15, 0.25, 0.05)
 K2 = tuple(2 * k for k in K)

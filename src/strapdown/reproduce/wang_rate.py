@@ -26,9 +26,9 @@ import numpy as np
 
 from strapdown import analysis, rate, sensors
 from strapdown._io import write_text
+from strapdown._report import ReportWriter, begin_report
 from strapdown.evaluate import EvaluationConfig, evaluate
 from strapdown.motions import ClassicalConing
-from strapdown.reproduce._report import ReportWriter, begin_report
 
 A_SMALL = 1e-9
 SPP = (600, 240, 120, 60)

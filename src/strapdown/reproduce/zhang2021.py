@@ -18,6 +18,7 @@ import numpy as np
 
 from strapdown import analysis
 from strapdown._io import markdown_table, write_text
+from strapdown._report import ReportWriter, begin_report
 from strapdown.cone_kinematics import integrate_cone_angles
 from strapdown.coning import (
     TABLE7,
@@ -26,7 +27,6 @@ from strapdown.coning import (
     triple_cross_rotation_vectors,
 )
 from strapdown.motions import ConeAngleMotion
-from strapdown.reproduce._report import ReportWriter, begin_report
 from strapdown.rotation.cone_angles import (
     cone_angles_from_dcm,
     cone_angles_from_quat,
