@@ -28,17 +28,7 @@ def _add_evaluate(sub) -> None:
         description="Run one configuration (motion → ideal gyro → algorithm) and report drift "
         "and error against exact truth. Human-readable by default, --json for machines.",
     )
-    p.add_argument("--motion", choices=["coning", "spin", "spin-coning", "krylov"],
-                   default="coning")
-    p.add_argument("--krylov-rates", type=float, nargs=3, metavar=("K1", "K2", "K3"),
-                   default=(0.15, 0.25, 0.05),
-                   help="krylov motion: angle rates (rad/s), angles k_i·t (Plaksiy)")
-    p.add_argument("--half-angle-deg", type=float, default=1.0, help="half cone angle (deg)")
-    p.add_argument("--cone-rate-hz", type=float, default=1.0, help="cone frequency Ω/2π (Hz)")
-    p.add_argument("--spin-rate-dps", type=float, default=0.0, help="spin rate (deg/s)")
-    p.add_argument("--sample-rate-hz", type=float, default=10_000.0,
-                   help="gyro increment rate 1/h (Hz)")
-    p.add_argument("--duration", type=float, default=2.0, help="simulated time (s)")
+    _motion_args(p)
     p.add_argument("--algorithm",
                    choices=["rotvec", "rate-single", "rate-three", "rk4", "miller", "panov",
                             "power"],
@@ -67,6 +57,20 @@ def _add_evaluate(sub) -> None:
     p.add_argument("--precision", type=int, default=None, metavar="DIGITS",
                    help="run in arbitrary precision with DIGITS significant digits")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+
+
+def _motion_args(p, rate_default: float | None = 10_000.0) -> None:
+    p.add_argument("--motion", choices=["coning", "spin", "spin-coning", "krylov"],
+                   default="coning")
+    p.add_argument("--krylov-rates", type=float, nargs=3, metavar=("K1", "K2", "K3"),
+                   default=(0.15, 0.25, 0.05),
+                   help="krylov motion: angle rates (rad/s), angles k_i·t (Plaksiy)")
+    p.add_argument("--half-angle-deg", type=float, default=1.0, help="half cone angle (deg)")
+    p.add_argument("--cone-rate-hz", type=float, default=1.0, help="cone frequency Ω/2π (Hz)")
+    p.add_argument("--spin-rate-dps", type=float, default=0.0, help="spin rate (deg/s)")
+    p.add_argument("--sample-rate-hz", type=float, default=rate_default,
+                   help="gyro increment rate 1/h (Hz; default 10000 for motions)")
+    p.add_argument("--duration", type=float, default=2.0, help="simulated time (s)")
 
 
 def _add_coefficients(sub) -> None:
@@ -171,9 +175,10 @@ def _add_run(sub) -> None:
     kind = p.add_mutually_exclusive_group(required=True)
     kind.add_argument("--rates", dest="kind", action="store_const", const="rate")
     kind.add_argument("--increments", dest="kind", action="store_const", const="increment")
-    p.add_argument("--units", required=True,
+    p.add_argument("--units", default=None,
                    choices=["rad/s", "deg/s", "rad", "deg"],
-                   help="rates: rad/s or deg/s; increments: rad or deg")
+                   help="rates: rad/s or deg/s; increments: rad or deg (required unless the "
+                   "CSV header declares it, e.g. gx[deg/s])")
     p.add_argument("--columns", default="t,gx,gy,gz",
                    help="CSV columns for time and the three axes (default t,gx,gy,gz)")
     p.add_argument("--sample-rate-hz", type=float, default=None)
@@ -184,6 +189,17 @@ def _add_run(sub) -> None:
     p.add_argument("--subsamples", type=int, default=3)
     p.add_argument("--coefficients", default=None)
     p.add_argument("--angles", choices=["ypr", "cone", "none"], default="ypr")
+    p.add_argument("--on-gap", choices=["report", "error", "split"], default="report",
+                   help="gaps (intervals > --gap-tolerance samples): report them (default), "
+                   "fail, or run each gap-free segment separately")
+    p.add_argument("--gap-tolerance", type=float, default=1.5,
+                   help="gap threshold in median sample intervals (default 1.5)")
+    p.add_argument("--saturation", type=float, default=None,
+                   help="sensor range in the declared unit; saturated rows are reported")
+    prog = p.add_mutually_exclusive_group()
+    prog.add_argument("--progress", dest="progress", action="store_true", default=None,
+                      help="progress bar on stderr (default: when stderr is a terminal)")
+    prog.add_argument("--no-progress", dest="progress", action="store_false")
     p.add_argument("--out", required=True, help="output .csv or .npz")
 
 
@@ -194,13 +210,105 @@ def _cmd_run(args) -> int:
     res = run_log(args.imu, args.out, kind=args.kind, units=args.units,
                   algorithm=args.algorithm, structure=args.structure,
                   subsamples=args.subsamples, coefficients=args.coefficients, columns=cols,
-                  sample_rate_hz=args.sample_rate_hz, angles=args.angles)
+                  sample_rate_hz=args.sample_rate_hz, angles=args.angles, on_gap=args.on_gap,
+                  gap_tolerance=args.gap_tolerance, saturation=args.saturation,
+                  progress=sys.stderr.isatty() if args.progress is None else args.progress)
     for w in res["warnings"]:
         print(f"warning: {w}", file=sys.stderr)
     if res["gaps"]:
-        print(f"warning: {len(res['gaps'])} gap(s), first at data row {res['gaps'][0]}",
+        how = "split into segments" if args.on_gap == "split" else "bridged"
+        print(f"warning: {len(res['gaps'])} gap(s) ({how}), first at data row {res['gaps'][0]}",
               file=sys.stderr)
+    if res["saturated"]:
+        print(f"warning: {len(res['saturated'])} saturated row(s), first at data row "
+              f"{res['saturated'][0]}", file=sys.stderr)
     print(f"wrote {args.out}: {res['outputs']} attitudes from {res['samples']} samples")
+    return 0
+
+
+def _add_compare(sub) -> None:
+    p = sub.add_parser("compare", help="several algorithms on one motion or one log",
+                       description="Run several algorithms on one reference motion (errors "
+                       "against exact truth) or on one gyro log (against --truth, or else "
+                       "relative to the first spec); write error_vs_time.png and summary.md/.csv.")
+    p.add_argument("--algorithms", nargs="+", required=True, metavar="SPEC",
+                   help="algorithm specs, e.g. rotvec:N=3 rotvec:N=3:structure=realtime "
+                   "rate-three:structure=sliding rk4 (keys: N, coefficients, structure, rk4_step, "
+                   "alpha, beta, step, exact_exp)")
+    _motion_args(p, rate_default=None)
+    p.add_argument("--imu", default=None, help="compare on this log instead of a motion")
+    kind = p.add_mutually_exclusive_group()
+    kind.add_argument("--rates", dest="kind", action="store_const", const="rate")
+    kind.add_argument("--increments", dest="kind", action="store_const", const="increment")
+    p.add_argument("--units", default=None, choices=["rad/s", "deg/s", "rad", "deg"])
+    p.add_argument("--columns", default="t,gx,gy,gz")
+    p.add_argument("--truth", default=None,
+                   help="log only: reference attitude file with t,qw,qx,qy,qz (CSV or .npz)")
+    p.add_argument("--out", required=True, help="output directory")
+
+
+def _cmd_compare(args) -> int:
+    from strapdown import compare
+
+    say = lambda msg: print(msg, file=sys.stderr)  # noqa: E731
+    if args.imu is None:
+        if args.kind or args.truth or args.units:
+            raise ValueError("--rates/--increments, --units and --truth belong to --imu")
+        from strapdown.evaluate import EvaluationConfig
+
+        base = EvaluationConfig(
+            motion=args.motion, half_angle_deg=args.half_angle_deg,
+            cone_rate_hz=args.cone_rate_hz, spin_rate_dps=args.spin_rate_dps,
+            sample_rate_hz=args.sample_rate_hz or 10_000.0, duration=args.duration,
+            krylov_rates=tuple(args.krylov_rates))
+        runs = compare.compare_motion(base, args.algorithms, args.out, progress=say)
+    else:
+        if args.kind is None:
+            raise ValueError("--imu needs --rates or --increments")
+        cols = tuple(c.strip() for c in args.columns.split(","))
+        runs = compare.compare_log(args.imu, args.algorithms, args.out, kind=args.kind,
+                                   units=args.units, columns=cols,
+                                   sample_rate_hz=args.sample_rate_hz, truth=args.truth,
+                                   progress=say)
+    for r in runs:
+        print(f"{r.label:40s} max {r.summary['max_error_rad']:.3e} rad  "
+              f"rms {r.summary['rms_error_rad']:.3e} rad")
+    return 0
+
+
+def _add_sweep(sub) -> None:
+    p = sub.add_parser("sweep", help="run a TOML scenario's parameter grid (resumable)",
+                       description="Run every case of a scenario file's grid; each finished case "
+                       "is saved at once, so an interrupted sweep resumes where it stopped. "
+                       "Writes OUT/results.csv and OUT/results.parquet when the grid is complete.")
+    p.add_argument("scenario", help="scenario file (.toml); see strapdown.sweep")
+    p.add_argument("--out", required=True, help="output directory")
+    p.add_argument("--scheduler", default="local",
+                   help="local (process pool, default) or dask://HOST:PORT")
+    p.add_argument("--workers", type=int, default=None,
+                   help="local pool size (default: CPU count; 1 runs in this process)")
+    p.add_argument("--format", default="csv,parquet",
+                   help="table formats, comma-separated: csv, parquet (default both)")
+    p.add_argument("--max-cases", type=int, default=None,
+                   help="compute at most this many new cases, then stop")
+    prog = p.add_mutually_exclusive_group()
+    prog.add_argument("--progress", dest="progress", action="store_true", default=None)
+    prog.add_argument("--no-progress", dest="progress", action="store_false")
+
+
+def _cmd_sweep(args) -> int:
+    from strapdown.sweep import sweep
+
+    res = sweep(args.scenario, args.out, scheduler=args.scheduler, workers=args.workers,
+                formats=[f.strip() for f in args.format.split(",") if f.strip()],
+                max_cases=args.max_cases,
+                progress=sys.stderr.isatty() if args.progress is None else args.progress,
+                log=lambda msg: print(msg, file=sys.stderr))
+    if not res.complete:
+        print(f"{res.skipped + res.computed} of {res.total} cases done; rerun to finish")
+        return 3
+    print(f"wrote {res.csv}" + (f" and {res.parquet}" if res.parquet else "")
+          + f" ({res.total} cases, {res.skipped} reused)")
     return 0
 
 
@@ -279,6 +387,8 @@ def build_parser() -> argparse.ArgumentParser:
     _add_coefficients(sub)
     _add_export(sub)
     _add_run(sub)
+    _add_compare(sub)
+    _add_sweep(sub)
     _add_reproduce(sub)
     b = sub.add_parser("bench", help="throughput benchmarks (ratios to a NumPy pass, peers)",
                        add_help=False)
@@ -296,7 +406,8 @@ def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     handlers = {"evaluate": _cmd_evaluate, "coefficients": _cmd_coefficients,
-                "reproduce": _cmd_reproduce, "export-c": _cmd_export, "run": _cmd_run}
+                "reproduce": _cmd_reproduce, "export-c": _cmd_export, "run": _cmd_run,
+                "compare": _cmd_compare, "sweep": _cmd_sweep}
     try:
         return handlers[args.command](args)
     except ValueError as exc:
