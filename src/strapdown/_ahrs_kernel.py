@@ -1,0 +1,514 @@
+"""The AHRS filter loop, compiled with numba (``cache=True``). Private.
+
+One function, :func:`ekf_kernel`, runs the whole multiplicative error-state
+EKF of :mod:`strapdown.ahrs` over a record: attitude propagation by a
+windowed rotation-vector algorithm (any of the library's rate or increment
+forms, conventional or sliding) or quaternion RK4, covariance propagation,
+rest (zero-rate) update, accelerometer and magnetometer-heading updates with
+innovation gating and recovery, Joseph-form update and reset. The public
+wrapper validates everything; the kernel trusts it. It is tested against its
+own plain-Python execution (``ekf_kernel.py_func``) and, for accuracy,
+against exact simulated truth.
+
+Frames: ENU reference; ``q`` is q_n_b (Hamilton, scalar first). Error state
+``x = [δθ_b, δb_g, a_b]`` with ``q_true = q̂ ⊗ q(δθ_b)``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from strapdown._kernels import _update
+
+# indices into the parameter vector (see strapdown.ahrs._params)
+P_GYRO_NOISE = 0
+P_BIAS_RW = 1
+P_SINGER_SIGMA = 2
+P_SINGER_TAU = 3
+P_ACC_NOISE = 4
+P_HEADING_NOISE = 5
+P_ACC_GATE = 6
+P_MAG_GATE = 7
+P_MAG_NORM_TOL = 8
+P_MAG_DIP_TOL = 9
+P_REF_NORM = 10
+P_REF_DIP = 11
+P_REF_HEADING = 12
+P_RECOVER_ACC = 13
+P_RECOVER_MAG = 14
+P_REST_GYRO = 15
+P_REST_ACC = 16
+P_REST_NOISE = 17
+P_REST_TAU = 18
+P_USE_ACC = 19
+P_USE_MAG = 20
+P_GATING = 21
+P_USE_REST = 22
+P_GRAVITY = 23
+P_RECOVER_ANGLE = 24
+P_ACC_NORM_TOL = 25
+P_MAG_SETTLE = 26
+P_SOFT_ACC = 27
+P_LEVER = 28
+P_ACC_LP_TAU = 29
+P_ACC_LP_NOISE = 30
+P_ACC_GATE_LP = 31
+N_PARAMS = 32
+
+# flags per output
+F_ACC_USED = 1
+F_ACC_REJECTED = 2
+F_MAG_USED = 4
+F_MAG_REJECTED = 8
+F_MAG_DISTURBED = 16
+F_REST = 32
+F_ACC_RECOVERED = 64
+F_MAG_RECOVERED = 128
+F_ACC_DISTURBED = 256
+
+
+@njit(cache=True, inline="always")
+def _dcm(q, c):
+    """C_n_b of q (3, 3) into c."""
+    w, x, y, z = q[0], q[1], q[2], q[3]
+    c[0, 0] = 1.0 - 2.0 * (y * y + z * z)
+    c[0, 1] = 2.0 * (x * y - w * z)
+    c[0, 2] = 2.0 * (x * z + w * y)
+    c[1, 0] = 2.0 * (x * y + w * z)
+    c[1, 1] = 1.0 - 2.0 * (x * x + z * z)
+    c[1, 2] = 2.0 * (y * z - w * x)
+    c[2, 0] = 2.0 * (x * z - w * y)
+    c[2, 1] = 2.0 * (y * z + w * x)
+    c[2, 2] = 1.0 - 2.0 * (x * x + y * y)
+
+
+@njit(cache=True, inline="always")
+def _left_rotate(eps, q):
+    """q ← q(ε) ⊗ q (a small reference-frame rotation), normalised."""
+    ang = np.sqrt(eps[0] * eps[0] + eps[1] * eps[1] + eps[2] * eps[2])
+    if ang < 1e-8:
+        s = 0.5 - ang * ang / 48.0
+        dw = 1.0 - ang * ang / 8.0
+    else:
+        s = np.sin(0.5 * ang) / ang
+        dw = np.cos(0.5 * ang)
+    ex, ey, ez = s * eps[0], s * eps[1], s * eps[2]
+    w = dw * q[0] - ex * q[1] - ey * q[2] - ez * q[3]
+    x = dw * q[1] + ex * q[0] + ey * q[3] - ez * q[2]
+    y = dw * q[2] - ex * q[3] + ey * q[0] + ez * q[1]
+    z = dw * q[3] + ex * q[2] - ey * q[1] + ez * q[0]
+    nrm = np.sqrt(w * w + x * x + y * y + z * z)
+    q[0] = w / nrm
+    q[1] = x / nrm
+    q[2] = y / nrm
+    q[3] = z / nrm
+
+
+@njit(cache=True)
+def _window_phi(x, b, offsets, weights, pi, pj, pc, sa, sb, bias_x, phi):
+    """φ of the windowed form over samples starting at b, bias removed from every node."""
+    m = offsets.size
+    nodes = np.empty((m, 3))
+    for n in range(m):
+        for a in range(3):
+            nodes[n, a] = x[b + offsets[n], a] - bias_x[a]
+    phi[0] = 0.0
+    phi[1] = 0.0
+    phi[2] = 0.0
+    for n in range(m):
+        for a in range(3):
+            phi[a] += sa * weights[n] * nodes[n, a]
+    for p in range(pi.size):
+        u = nodes[pi[p]]
+        v = nodes[pj[p]]
+        c = sb * pc[p]
+        phi[0] += c * (u[1] * v[2] - u[2] * v[1])
+        phi[1] += c * (u[2] * v[0] - u[0] * v[2])
+        phi[2] += c * (u[0] * v[1] - u[1] * v[0])
+
+
+@njit(cache=True)
+def _rk4(q, w0, w1, w2, h2, out):
+    """One quaternion RK4 step of length h2 with rates at start, middle, end."""
+    k = np.empty((4, 4))
+    y = q.copy()
+    for s in range(4):
+        if s == 0:
+            w = w0
+            y[:] = q
+        elif s == 1 or s == 2:
+            w = w1
+            for i in range(4):
+                y[i] = q[i] + 0.5 * h2 * k[s - 1, i]
+        else:
+            w = w2
+            for i in range(4):
+                y[i] = q[i] + h2 * k[2, i]
+        k[s, 0] = 0.5 * (-y[1] * w[0] - y[2] * w[1] - y[3] * w[2])
+        k[s, 1] = 0.5 * (y[0] * w[0] + y[2] * w[2] - y[3] * w[1])
+        k[s, 2] = 0.5 * (y[0] * w[1] - y[1] * w[2] + y[3] * w[0])
+        k[s, 3] = 0.5 * (y[0] * w[2] + y[1] * w[1] - y[2] * w[0])
+    nrm = 0.0
+    for i in range(4):
+        out[i] = q[i] + h2 / 6.0 * (k[0, i] + 2.0 * k[1, i] + 2.0 * k[2, i] + k[3, i])
+        nrm += out[i] * out[i]
+    nrm = np.sqrt(nrm)
+    for i in range(4):
+        out[i] /= nrm
+
+
+@njit(cache=True)
+def _joseph(P, H, R, y, gate, gating, force, dx, soft=False):
+    """Gated Joseph-form update of P with (H, R, y); returns (NIS, accepted). dx += K y.
+
+    Beyond the gate a hard gate rejects; a soft gate de-weights instead (R scaled by NIS/gate,
+    a Huber-type bounded step).
+    """
+    m = y.size
+    PHt = P @ H.T
+    S = H @ PHt + R
+    Sinv = np.linalg.inv(S)
+    nis = 0.0
+    for i in range(m):
+        for j in range(m):
+            nis += y[i] * Sinv[i, j] * y[j]
+    if gating and nis > gate and not force:
+        if not soft:
+            return nis, False
+        R = R * (nis / gate)
+        S = H @ PHt + R
+        Sinv = np.linalg.inv(S)
+    K = PHt @ Sinv
+    IKH = np.eye(P.shape[0]) - K @ H
+    P[:, :] = IKH @ P @ IKH.T + K @ R @ K.T
+    dx += K @ y
+    return nis, True
+
+
+@njit(cache=True)
+def ekf_kernel(x, is_rate, h, offsets, weights, pi, pj, pc, stride, span, end_off, lag,
+               start_c, rk4, acc, mag, params, q0, b0, P0,
+               out_q, out_b, out_a, out_idx, out_flags, out_nis, out_sig):
+    """Run the filter; returns the number of outputs written.
+
+    ``x``: rates (n, 3) if ``is_rate`` else increments (n − 1, 3); sample ``i``
+    of ``acc``/``mag`` is at time ``i h``. Windowed form: epoch ``e`` uses
+    nodes ``x[e·stride + offsets]`` and outputs at sample ``e·stride + end_off``;
+    its base attitude is the output ``lag`` epochs earlier (``lag > 1``: the
+    sliding scheme, started by single-period steps with coefficient
+    ``start_c``). ``rk4``: quaternion RK4 over two rate intervals.
+    """
+    n_samples = acc.shape[0]
+    sa = h if is_rate else 1.0
+    sb = h * h if is_rate else 1.0
+    g = params[P_GRAVITY]
+    use_acc = params[P_USE_ACC] != 0.0
+    use_mag = params[P_USE_MAG] != 0.0
+    gating = params[P_GATING] != 0.0
+    use_rest = params[P_USE_REST] != 0.0
+    P = P0.copy()
+    q = q0.copy()
+    bias = b0.copy()
+    accel = np.zeros(3)
+    ring = np.zeros((lag, 4))  # outputs of the last `lag` epochs (the sliding bases)
+    for i in range(lag):
+        ring[i] = q0
+    C = np.empty((3, 3))
+    phi = np.empty(3)
+    tmp = np.empty(4)
+    dx = np.zeros(9)
+    eps = np.empty(3)
+    bias_x = np.empty(3)
+    # rest detector (exponential moving averages of gyro and accelerometer)
+    gm = np.zeros(3)
+    g2 = np.zeros(3)
+    am = np.zeros(3)
+    a2 = np.zeros(3)
+    rest_alpha = h / params[P_REST_TAU]
+    ema_n = 0.0
+    acc_bad_since = -1.0
+    mag_bad_since = -1.0
+    mag_clean_since = -1.0  # start of the current run of plausible magnetometer samples
+    lp_tau = params[P_ACC_LP_TAU]
+    lp = np.zeros(3)
+    fn = np.zeros(3)
+    lp_init = False
+    n_out = 0
+    last = 0  # last sample folded into the rest detector
+    # start-up outputs of the sliding scheme (samples 1 … lag−1 by single-period steps)
+    e = 0
+    n_start = lag - 1 if lag > 1 else 0
+    n_epochs = 0
+    if rk4:
+        n_epochs = (n_samples - 1) // 2
+    else:
+        n_x = x.shape[0]
+        if n_x - 1 - offsets.max() >= 0:
+            n_epochs = (n_x - 1 - offsets.max()) // stride + 1
+    total = n_start + n_epochs
+    for step in range(total):
+        # ---------------- attitude propagation ----------------
+        for a in range(3):
+            bias_x[a] = bias[a] if is_rate else bias[a] * h
+        if step < n_start:
+            k = step + 1  # output sample
+            u0 = x[k - 1]
+            u1 = x[k]
+            for a in range(3):
+                ua = u0[a] - bias[a]
+                phi[a] = 0.5 * h * (ua + u1[a] - bias[a])
+            wa0, wa1, wa2 = u0[0] - bias[0], u0[1] - bias[1], u0[2] - bias[2]
+            wb0, wb1, wb2 = u1[0] - bias[0], u1[1] - bias[1], u1[2] - bias[2]
+            c = start_c * h * h
+            phi[0] += c * (wa1 * wb2 - wa2 * wb1)
+            phi[1] += c * (wa2 * wb0 - wa0 * wb2)
+            phi[2] += c * (wa0 * wb1 - wa1 * wb0)
+            _update(q, phi, tmp)
+            q[:] = tmp
+            T = h
+        elif rk4:
+            e = step
+            k = 2 * e + 2
+            w0 = x[k - 2] - bias
+            w1 = x[k - 1] - bias
+            w2 = x[k] - bias
+            _rk4(q, w0, w1, w2, 2.0 * h, tmp)
+            q[:] = tmp
+            T = 2.0 * h
+            for a in range(3):
+                phi[a] = w1[a] * T
+        else:
+            e = step - n_start
+            b = e * stride
+            k = b + end_off
+            _window_phi(x, b, offsets, weights, pi, pj, pc, sa, sb, bias_x, phi)
+            base = ring[e % lag] if lag > 1 else q
+            _update(base, phi, tmp)
+            q[:] = tmp
+            T = stride * h
+            if lag > 1:
+                for a in range(3):
+                    phi[a] = phi[a] / lag  # per-epoch rotation for the covariance
+        # ---------------- rest detector over the samples of this epoch ----------------
+        while last < k:
+            last += 1
+            ema_n += 1.0
+            al = max(rest_alpha, 1.0 / ema_n)
+            for a in range(3):
+                wv = x[min(last, x.shape[0] - 1), a] if is_rate else x[last - 1, a] / h
+                gm[a] += al * (wv - gm[a])
+                g2[a] += al * (wv * wv - g2[a])
+                am[a] += al * (acc[last, a] - am[a])
+                a2[a] += al * (acc[last, a] * acc[last, a] - a2[a])
+        # ---------------- covariance propagation ----------------
+        # Φ_θθ = exp(−[φ×]) ≈ I − [φ×] + ½[φ×]², Φ_θb = −T I, Φ_aa = e^{−T/τ} I
+        Phi = np.eye(9)
+        px, py, pz = phi[0], phi[1], phi[2]
+        Sk = np.array([[0.0, -pz, py], [pz, 0.0, -px], [-py, px, 0.0]])
+        Sk2 = Sk @ Sk
+        for r in range(3):
+            for s in range(3):
+                Phi[r, s] += -Sk[r, s] + 0.5 * Sk2[r, s]
+            Phi[r, 3 + r] = -T
+            Phi[6 + r, 6 + r] = np.exp(-T / params[P_SINGER_TAU])
+        Q = np.zeros((9, 9))
+        qa = params[P_SINGER_SIGMA] ** 2 * (1.0 - np.exp(-2.0 * T / params[P_SINGER_TAU]))
+        for r in range(3):
+            Q[r, r] = params[P_GYRO_NOISE] ** 2 * T
+            Q[3 + r, 3 + r] = params[P_BIAS_RW] ** 2 * T
+            Q[6 + r, 6 + r] = qa
+        P = Phi @ P @ Phi.T + Q
+        # ---------------- measurement updates ----------------
+        flags = 0
+        dx[:] = 0.0
+        tk = k * h
+        _dcm(q, C)
+        sg = 0.0
+        sacc = 0.0
+        for a in range(3):
+            sg += max(g2[a] - gm[a] * gm[a], 0.0)
+            sacc += max(a2[a] - am[a] * am[a], 0.0)
+        wm = np.sqrt(gm[0] ** 2 + gm[1] ** 2 + gm[2] ** 2)
+        amn = np.sqrt(am[0] ** 2 + am[1] ** 2 + am[2] ** 2)
+        settled = ema_n * rest_alpha > 1.0
+        # quiet accelerometer: low variance and a mean of magnitude g (no sustained manoeuvre)
+        acc_quiet = (settled and np.sqrt(sacc) < params[P_REST_ACC]
+                     and abs(amn - g) < params[P_REST_ACC])
+        if use_rest:
+            if (acc_quiet and np.sqrt(sg) < params[P_REST_GYRO]
+                    and wm < 5.0 * params[P_REST_GYRO]):
+                H = np.zeros((3, 9))
+                for a in range(3):
+                    H[a, 3 + a] = 1.0
+                R = np.eye(3) * params[P_REST_NOISE] ** 2
+                y = gm - (bias + dx[3:6])
+                _joseph(P, H, R, y, 0.0, False, True, dx)
+                flags |= F_REST
+        nis_acc = np.nan
+        if use_acc and lp_tau > 0.0:
+            # low-pass model: the specific force in the reference frame, averaged over τ,
+            # is gravity (manoeuvres average out); lp − g_up ≈ [g_up×] C δθ (horizontal rows)
+            for a in range(3):
+                fn[a] = C[a, 0] * acc[k, 0] + C[a, 1] * acc[k, 1] + C[a, 2] * acc[k, 2]
+            if not lp_init:
+                lp[:] = fn
+                lp_init = True
+            else:
+                al = min(1.0, T / lp_tau)
+                for a in range(3):
+                    lp[a] += al * (fn[a] - lp[a])
+            H = np.zeros((2, 9))
+            for a in range(3):
+                H[0, a] = -g * C[1, a]
+                H[1, a] = g * C[0, a]
+            y = np.empty(2)
+            y[0] = lp[0]
+            y[1] = lp[1]
+            y -= H @ dx
+            R = np.eye(2) * params[P_ACC_LP_NOISE] ** 2
+            force = False
+            if (gating and acc_quiet and acc_bad_since >= 0.0
+                    and tk - acc_bad_since > params[P_RECOVER_ACC]):
+                ra = params[P_RECOVER_ANGLE] ** 2
+                for a in range(3):
+                    P[a, a] += ra
+                force = True
+                flags |= F_ACC_RECOVERED
+            nis_acc, ok = _joseph(P, H, R, y, params[P_ACC_GATE_LP], gating, force, dx,
+                                  params[P_SOFT_ACC] != 0.0)
+            if ok:
+                flags |= F_ACC_USED
+                acc_bad_since = -1.0
+            else:
+                flags |= F_ACC_REJECTED
+                if acc_bad_since < 0.0:
+                    acc_bad_since = tk
+        elif use_acc:
+            v = np.empty(3)
+            for a in range(3):
+                v[a] = C[2, a] * g  # C_b_n [0, 0, g]
+            H = np.zeros((3, 9))
+            H[0, 1] = -v[2]
+            H[0, 2] = v[1]
+            H[1, 0] = v[2]
+            H[1, 2] = -v[0]
+            H[2, 0] = -v[1]
+            H[2, 1] = v[0]
+            for a in range(3):
+                H[a, 6 + a] = 1.0
+            fa = np.sqrt(acc[k, 0] ** 2 + acc[k, 1] ** 2 + acc[k, 2] ** 2)
+            acc_disturbed = gating and abs(fa - g) > params[P_ACC_NORM_TOL] * g
+            y = np.empty(3)
+            for a in range(3):
+                y[a] = acc[k, a] - (v[a] + accel[a])
+            y -= H @ dx
+            # rotation seen at a lever arm (centripetal + tangential) widens the noise
+            kk = min(k, x.shape[0] - 1)
+            if is_rate:
+                w2 = 0.0
+                wd2 = 0.0
+                for a in range(3):
+                    wa = x[kk, a] - bias[a]
+                    w2 += wa * wa
+                    wd2 += ((x[kk, a] - x[kk - 1, a]) / h) ** 2
+            else:
+                w2 = 0.0
+                wd2 = 0.0
+                for a in range(3):
+                    wa = x[kk, a] / h - bias[a]
+                    w2 += wa * wa
+                    wd2 += ((x[kk, a] - x[kk - 1, a]) / (h * h)) ** 2
+            lever = params[P_LEVER] * (w2 + np.sqrt(wd2))
+            R = np.eye(3) * (params[P_ACC_NOISE] ** 2 + lever * lever)
+            force = False
+            if (gating and acc_quiet and acc_bad_since >= 0.0
+                    and tk - acc_bad_since > params[P_RECOVER_ACC]):
+                ra = params[P_RECOVER_ANGLE] ** 2
+                for a in range(3):
+                    P[a, a] += ra
+                    P[6 + a, 6 + a] += params[P_SINGER_SIGMA] ** 2
+                force = True
+                flags |= F_ACC_RECOVERED
+            if acc_disturbed:
+                flags |= F_ACC_DISTURBED
+            else:
+                nis_acc, ok = _joseph(P, H, R, y, params[P_ACC_GATE], gating, force, dx,
+                                      params[P_SOFT_ACC] != 0.0)
+                if ok:
+                    flags |= F_ACC_USED
+                    acc_bad_since = -1.0
+                else:
+                    flags |= F_ACC_REJECTED
+                    if acc_bad_since < 0.0:
+                        acc_bad_since = tk
+        nis_mag = np.nan
+        if use_mag:
+            mb = mag[k]
+            nb = np.sqrt(mb[0] ** 2 + mb[1] ** 2 + mb[2] ** 2)
+            mn = C @ mb
+            mh = np.sqrt(mn[0] ** 2 + mn[1] ** 2)
+            dip = np.arctan2(-mn[2], mh)
+            disturbed = (abs(nb - params[P_REF_NORM]) > params[P_MAG_NORM_TOL] * params[P_REF_NORM]
+                         or abs(dip - params[P_REF_DIP]) > params[P_MAG_DIP_TOL])
+            if disturbed:
+                mag_clean_since = -1.0
+            elif mag_clean_since < 0.0:
+                mag_clean_since = tk
+            if gating and (disturbed or tk - mag_clean_since < params[P_MAG_SETTLE]):
+                flags |= F_MAG_DISTURBED
+            else:
+                H = np.zeros((1, 9))
+                for a in range(3):
+                    H[0, a] = -C[2, a]
+                yv = np.arctan2(mn[1], mn[0]) - params[P_REF_HEADING]
+                yv = (yv + np.pi) % (2.0 * np.pi) - np.pi
+                y = np.array([yv]) - H @ dx
+                R = np.eye(1) * params[P_HEADING_NOISE] ** 2
+                force = False
+                if (gating and mag_bad_since >= 0.0
+                        and tk - mag_bad_since > params[P_RECOVER_MAG]):
+                    ra = params[P_RECOVER_ANGLE] ** 2
+                    for r in range(3):
+                        for s in range(3):
+                            P[r, s] += ra * C[2, r] * C[2, s]
+                    force = True
+                    flags |= F_MAG_RECOVERED
+                nis_mag, ok = _joseph(P, H, R, y, params[P_MAG_GATE], gating, force, dx)
+                if ok:
+                    flags |= F_MAG_USED
+                    mag_bad_since = -1.0
+                else:
+                    flags |= F_MAG_REJECTED
+                    if mag_bad_since < 0.0:
+                        mag_bad_since = tk
+        # ---------------- reset ----------------
+        for a in range(3):
+            eps[a] = C[a, 0] * dx[0] + C[a, 1] * dx[1] + C[a, 2] * dx[2]
+        _left_rotate(eps, q)
+        if lp_init:  # the averaged reference-frame specific force follows the correction
+            l0 = lp[0] + eps[1] * lp[2] - eps[2] * lp[1]
+            l1 = lp[1] + eps[2] * lp[0] - eps[0] * lp[2]
+            l2 = lp[2] + eps[0] * lp[1] - eps[1] * lp[0]
+            lp[0] = l0
+            lp[1] = l1
+            lp[2] = l2
+        if lag > 1:  # the bases of the other chains share the reference frame: correct them too
+            for r in range(lag):
+                _left_rotate(eps, ring[r])
+            ring[(e if step >= n_start else step + 1) % lag] = q
+        for a in range(3):
+            bias[a] += dx[3 + a]
+            accel[a] += dx[6 + a]
+        P = 0.5 * (P + P.T)
+        out_q[n_out] = q
+        out_b[n_out] = bias
+        out_a[n_out] = accel
+        out_idx[n_out] = k
+        out_flags[n_out] = flags
+        out_nis[n_out, 0] = nis_acc
+        out_nis[n_out, 1] = nis_mag
+        for a in range(3):
+            out_sig[n_out, a] = np.sqrt(max(P[a, a], 0.0))
+        n_out += 1
+    return n_out
