@@ -1,4 +1,4 @@
-"""Gyro models: ideal increments, rate samples, pre-averaged oversampling, seeded errors.
+"""Sensor models: gyro (increments, rates, pre-averaging), accelerometer and magnetometer, seeded.
 
 Data flow: a :class:`~strapdown.motions.Motion` gives exact increments or
 rates; :class:`GyroErrors` corrupts them reproducibly from a seed or a
@@ -15,9 +15,13 @@ from strapdown._validation import finite_array, positive, positive_int
 from strapdown.motions import Motion
 
 __all__ = [
+    "AccelerometerErrors",
     "GyroErrors",
     "GyroRecord",
+    "MagnetometerErrors",
+    "accelerometer",
     "increments",
+    "magnetometer",
     "preaveraged_increments",
     "rate_samples",
 ]
@@ -206,3 +210,114 @@ def preaveraged_increments(motion: Motion, h: float, n: int, m: int, *, t0: floa
         w = errors.apply(w, "rate", sub, rng)
     theta = w.reshape(n, m, 3).mean(axis=1) * h
     return GyroRecord(edges, theta, "increment", h)
+
+
+@dataclass(frozen=True)
+class AccelerometerErrors:
+    """Accelerometer error model (zero by default = ideal).
+
+    ``f_meas = (I + diag(scale_factor)) (f + b) + vibration(t) + n`` with
+    ``n`` white of density ``white_noise`` (m/s²/√Hz) and the vibration a sum
+    of a sinusoid (``vibration_amplitude`` m/s² per axis at
+    ``vibration_hz``, random phases) and white ``vibration_noise`` (m/s²
+    per sample) switched on between ``vibration_start`` and ``vibration_stop``.
+    """
+
+    white_noise: float = 0.0
+    bias: float | np.ndarray = 0.0
+    scale_factor: float | np.ndarray = 0.0
+    vibration_amplitude: float = 0.0
+    vibration_hz: float = 30.0
+    vibration_noise: float = 0.0
+    vibration_start: float = 0.0
+    vibration_stop: float = np.inf
+
+    def __post_init__(self):
+        for name in ("white_noise", "vibration_amplitude", "vibration_noise"):
+            if not float(getattr(self, name)) >= 0:
+                raise ValueError(f"{name} must be non-negative, got {getattr(self, name)!r}")
+        positive(self.vibration_hz, "vibration_hz")
+        for name in ("bias", "scale_factor"):
+            _vec3(getattr(self, name), name)
+        if not self.vibration_stop >= self.vibration_start:
+            raise ValueError("vibration_stop must not precede vibration_start")
+
+    def apply(self, t, f, h: float, rng) -> np.ndarray:
+        """Corrupt the true specific force ``f`` (n, 3) sampled at ``t`` every ``h`` s."""
+        rng = np.random.default_rng(rng)
+        t = np.asarray(t, float)
+        n = f.shape[0]
+        x = (f + _vec3(self.bias, "bias")) * (1.0 + _vec3(self.scale_factor, "scale_factor"))
+        on = ((t >= self.vibration_start) & (t < self.vibration_stop))[:, None]
+        phase = rng.uniform(0.0, 2.0 * np.pi, 3)
+        vib = self.vibration_amplitude * np.sin(2 * np.pi * self.vibration_hz * t[:, None]
+                                                + phase)
+        vib = vib + self.vibration_noise * rng.standard_normal((n, 3))
+        x = x + np.where(on, vib, 0.0)
+        if self.white_noise > 0:
+            x = x + self.white_noise / np.sqrt(h) * rng.standard_normal((n, 3))
+        return x
+
+
+@dataclass(frozen=True)
+class MagnetometerErrors:
+    """Magnetometer error model (zero by default = ideal).
+
+    ``m_meas = S (m_b + anomaly_b) + hard_iron + n``: ``S = I + soft_iron`` (3, 3),
+    ``hard_iron`` a constant body-frame offset, ``n`` white (per sample, same
+    unit as the field), and a magnetic anomaly — a reference-frame field
+    ``anomaly`` (3,) added between ``anomaly_start`` and ``anomaly_stop``.
+    """
+
+    white_noise: float = 0.0
+    hard_iron: float | np.ndarray = 0.0
+    soft_iron: np.ndarray = field(default_factory=lambda: np.zeros((3, 3)))
+    anomaly: float | np.ndarray = 0.0
+    anomaly_start: float = 0.0
+    anomaly_stop: float = 0.0
+
+    def __post_init__(self):
+        if not float(self.white_noise) >= 0:
+            raise ValueError(f"white_noise must be non-negative, got {self.white_noise!r}")
+        s = finite_array(self.soft_iron, "soft_iron")
+        if s.shape != (3, 3):
+            raise ValueError(f"soft_iron must have shape (3, 3), got {s.shape}")
+        _vec3(self.hard_iron, "hard_iron")
+        _vec3(self.anomaly, "anomaly")
+
+    def apply(self, t, m_b, c_b_n, rng) -> np.ndarray:
+        """Corrupt the true body-frame field ``m_b`` (n, 3); ``c_b_n`` (n, 3, 3) rotates the
+        anomaly into the body."""
+        rng = np.random.default_rng(rng)
+        t = np.asarray(t, float)
+        on = ((t >= self.anomaly_start) & (t < self.anomaly_stop))[:, None]
+        an = np.einsum("nij,j->ni", c_b_n, _vec3(self.anomaly, "anomaly"))
+        x = (m_b + np.where(on, an, 0.0)) @ (np.eye(3) + np.asarray(self.soft_iron)).T
+        x = x + _vec3(self.hard_iron, "hard_iron")
+        if self.white_noise > 0:
+            x = x + self.white_noise * rng.standard_normal(m_b.shape)
+        return x
+
+
+def accelerometer(t, q_n_b, specific_force, h: float, *, errors: AccelerometerErrors | None = None,
+                  rng=None) -> np.ndarray:
+    """Accelerometer samples (m/s²) of the true body specific force, corrupted if asked.
+
+    ``q_n_b`` is accepted for symmetry with :func:`magnetometer` and unused.
+    """
+    f = np.asarray(specific_force, float)
+    if errors is None:
+        return f.copy()
+    return errors.apply(t, f, positive(h, "h"), rng)
+
+
+def magnetometer(t, q_n_b, field_n, *, errors: MagnetometerErrors | None = None,
+                 rng=None) -> np.ndarray:
+    """Magnetometer samples: the reference-frame field ``field_n`` (3,) seen in the body."""
+    from strapdown.rotation.dcm import dcm_from_quat
+
+    c_b_n = np.swapaxes(dcm_from_quat(q_n_b), -1, -2)
+    m_b = np.einsum("nij,j->ni", c_b_n, np.asarray(field_n, float))
+    if errors is None:
+        return m_b
+    return errors.apply(t, m_b, c_b_n, rng)
