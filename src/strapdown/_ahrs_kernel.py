@@ -10,6 +10,10 @@ wrapper validates everything; the kernel trusts it. It is tested against its
 own plain-Python execution (``ekf_kernel.py_func``) and, for accuracy,
 against exact simulated truth.
 
+Measurement noises are densities: an update every ``T`` seconds uses
+``R = density² / T``, so the filter's bandwidth does not depend on the
+propagation algorithm's update period.
+
 Frames: ENU reference; ``q`` is q_n_b (Hamilton, scalar first). Error state
 ``x = [δθ_b, δb_g, a_b]`` with ``q_true = q̂ ⊗ q(δθ_b)``.
 """
@@ -341,7 +345,7 @@ def ekf_kernel(x, is_rate, h, offsets, weights, pi, pj, pc, stride, span, end_of
                 H = np.zeros((3, 9))
                 for a in range(3):
                     H[a, 3 + a] = 1.0
-                R = np.eye(3) * params[P_REST_NOISE] ** 2
+                R = np.eye(3) * params[P_REST_NOISE] ** 2 / T
                 y = gm - (bias + dx[3:6])
                 _joseph(P, H, R, y, 0.0, False, True, dx)
                 flags |= F_REST
@@ -366,7 +370,7 @@ def ekf_kernel(x, is_rate, h, offsets, weights, pi, pj, pc, stride, span, end_of
             y[0] = lp[0]
             y[1] = lp[1]
             y -= H @ dx
-            R = np.eye(2) * params[P_ACC_LP_NOISE] ** 2
+            R = np.eye(2) * params[P_ACC_LP_NOISE] ** 2 / T
             force = False
             if (gating and acc_quiet and acc_bad_since >= 0.0
                     and tk - acc_bad_since > params[P_RECOVER_ACC]):
@@ -420,7 +424,7 @@ def ekf_kernel(x, is_rate, h, offsets, weights, pi, pj, pc, stride, span, end_of
                     w2 += wa * wa
                     wd2 += ((x[kk, a] - x[kk - 1, a]) / (h * h)) ** 2
             lever = params[P_LEVER] * (w2 + np.sqrt(wd2))
-            R = np.eye(3) * (params[P_ACC_NOISE] ** 2 + lever * lever)
+            R = np.eye(3) * (params[P_ACC_NOISE] ** 2 / T + lever * lever)
             force = False
             if (gating and acc_quiet and acc_bad_since >= 0.0
                     and tk - acc_bad_since > params[P_RECOVER_ACC]):
@@ -464,7 +468,7 @@ def ekf_kernel(x, is_rate, h, offsets, weights, pi, pj, pc, stride, span, end_of
                 yv = np.arctan2(mn[1], mn[0]) - params[P_REF_HEADING]
                 yv = (yv + np.pi) % (2.0 * np.pi) - np.pi
                 y = np.array([yv]) - H @ dx
-                R = np.eye(1) * params[P_HEADING_NOISE] ** 2
+                R = np.eye(1) * params[P_HEADING_NOISE] ** 2 / T
                 force = False
                 if (gating and mag_bad_since >= 0.0
                         and tk - mag_bad_since > params[P_RECOVER_MAG]):

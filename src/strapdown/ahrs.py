@@ -28,8 +28,9 @@ papers.md describes):
   not the sensor, must be wrong: it inflates the affected covariance and
   accepts again;
 - **initial attitude** from the mean accelerometer and magnetometer over
-  ``init_window_s`` (TRIAD) when none is given; the reference field
-  (norm, dip, heading) is learned there too.
+  ``init_window_s`` (TRIAD) when none is given (the window is assumed at
+  rest); the reference field (norm, dip, heading) is learned there too,
+  unless given.
 
 Frames: the filter runs in ENU (x east, y north, z up); ``frame="NED"``
 returns q_NED_b. Heading is magnetic unless ``declination_deg`` is given.
@@ -81,10 +82,33 @@ class AhrsConfig:
     singer_tau : float
         Its correlation time, s. Default 0.2.
     acc_noise : float
-        Accelerometer measurement noise (white noise plus vibration), m/s². Default 0.5.
+        Raw accelerometer model (``acc_model="raw"``): measurement noise
+        density (white noise plus vibration), m/s²/√Hz. Default 0.03. All
+        measurement noises are densities — an update every ``T`` s uses
+        ``R = density²/T`` — so the filter does not change with the
+        propagation algorithm's update period.
+    acc_model : {"lowpass", "raw"}
+        ``lowpass`` (default): the specific force rotated into the reference
+        frame and averaged over ``acc_lowpass_s`` is gravity — manoeuvre
+        accelerations average out (the idea of Laidig & Seel's VQF); the
+        Singer state is then unused. ``raw``: the paper's model, each sample
+        ``f = C_b_n g_up + a_b`` with the Singer state ``a_b``.
+    acc_lowpass_s : float
+        Averaging time constant, s. Default 3.
+    acc_lowpass_noise : float
+        Noise density of the averaged horizontal specific force, m/s²/√Hz.
+        Default 0.018.
+    acc_gate_lowpass : float
+        NIS gate of the averaged measurement (χ², 2 dof, 99.9 %: 13.82).
+    acc_gate_mode : {"hard", "soft"}
+        Beyond the gate: reject (hard, default) or de-weight (soft, Huber-type).
+    lever_arm : float
+        Raw model only: distance (m) from the centre of rotation used to widen
+        the accelerometer noise by the centripetal and tangential accelerations
+        the gyro sees. Default 0.1.
     heading_noise : float
-        Magnetometer heading noise, rad. Default 0.15 (local field distortion
-        dominates the sensor noise indoors).
+        Magnetometer heading noise density, rad/√Hz. Default 0.018 (local
+        field distortion dominates the sensor noise indoors).
     acc_gate, mag_gate : float
         NIS thresholds (χ² with 3 and 1 degrees of freedom at 99.9 %: 16.27, 10.83).
     mag_norm_tol : float
@@ -109,7 +133,7 @@ class AhrsConfig:
         ``rest_gyro`` (rad/s) and its mean below 5 × that, and the
         accelerometer's below ``rest_acc`` (m/s²). Defaults 0.01, 0.2.
     rest_noise : float
-        Noise of the zero-rate bias measurement, rad/s. Default 0.002.
+        Noise density of the zero-rate bias measurement, rad/s/√Hz. Default 1.2e-4.
     rest_tau : float
         Averaging time of the rest detector, s. Default 0.5.
     gating : bool
@@ -133,15 +157,15 @@ class AhrsConfig:
     gyro_bias_sigma0: float = 0.01
     singer_sigma: float = 2.0
     singer_tau: float = 0.2
-    acc_noise: float = 0.5
-    heading_noise: float = 0.3
+    acc_noise: float = 0.03
+    heading_noise: float = 0.018
     acc_gate: float = 16.27
     mag_gate: float = 10.83
     mag_norm_tol: float = 0.1
     mag_dip_tol: float = 0.17
     acc_model: str = "lowpass"
     acc_lowpass_s: float = 3.0
-    acc_lowpass_noise: float = 0.3
+    acc_lowpass_noise: float = 0.018
     acc_gate_lowpass: float = 13.82
     acc_gate_mode: str = "hard"
     lever_arm: float = 0.1
@@ -152,7 +176,7 @@ class AhrsConfig:
     recover_angle: float = 0.1
     rest_gyro: float = 0.01
     rest_acc: float = 0.2
-    rest_noise: float = 0.002
+    rest_noise: float = 1.2e-4
     rest_tau: float = 0.5
     gating: bool = True
     rest_update: bool = True
@@ -355,7 +379,7 @@ def _check(name, a, n):
 
 def ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
         config: AhrsConfig | None = None, q0=None, gyro_bias0=None,
-        frame: str = "ENU") -> AhrsResult:
+        mag_reference=None, frame: str = "ENU") -> AhrsResult:
     """Run the AHRS filter over uniformly sampled gyro, accelerometer and magnetometer data.
 
     Parameters
@@ -376,6 +400,10 @@ def ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
         Initial q_n_b in ``frame``; default from the accelerometer and magnetometer.
     gyro_bias0 : array_like (3,), optional
         Initial bias estimate, rad/s (default zero).
+    mag_reference : array_like (3,), optional
+        The local magnetic field in ENU (same unit as ``mag``). Default: learned
+        over ``init_window_s`` — averaged at rest when ``q0`` is None, else
+        rotated into the reference frame along the gyro-propagated attitude.
     frame : {"ENU", "NED"}
     """
     from strapdown.rate import check_rate_record
@@ -395,11 +423,11 @@ def ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
                          f"{cfg.gravity} m/s² (is it in g, or not specific force?)")
     if have_mag and np.median(np.linalg.norm(mag, axis=1)) == 0:
         raise ValueError("the magnetometer reads zero; pass mag=None for no heading")
-    w = max(1, min(n, round(cfg.init_window_s / h)))
+    w = max(2, min(n, round(cfg.init_window_s / h)))
     if q0 is None:  # the initial window is assumed at rest: average it
         f0 = acc[:w].mean(axis=0)
         m0 = mag[:w].mean(axis=0) if have_mag else None
-    else:  # the attitude is given: take the field at the first sample
+    else:
         f0 = acc[0]
         m0 = mag[0] if have_mag else None
     if q0 is None:
@@ -413,8 +441,19 @@ def ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
 
     ref = (0.0, 0.0, 0.0)
     if have_mag:
-        mn = dcm_from_quat(q_init) @ m0
-        ref = (float(np.linalg.norm(m0)), math.atan2(-mn[2], math.hypot(mn[0], mn[1])),
+        if mag_reference is not None:  # the local field is known (ENU)
+            mn = np.asarray(mag_reference, float)
+            if mn.shape != (3,) or not np.all(np.isfinite(mn)) or not np.linalg.norm(mn) > 0:
+                raise ValueError(f"mag_reference must be a finite non-zero (3,) ENU vector, "
+                                 f"got {mag_reference!r}")
+        elif q0 is None:
+            mn = dcm_from_quat(q_init) @ m0
+        else:  # learn the field over the window along the gyro-propagated attitude
+            from strapdown.rate import rate_attitude
+
+            qw = rate_attitude(rec.t[:w], rec.omega[:w], algorithm="rate-single", q0=q_init).q
+            mn = np.einsum("nij,nj->ni", dcm_from_quat(qw), mag[:w]).mean(axis=0)
+        ref = (float(np.linalg.norm(mn)), math.atan2(-mn[2], math.hypot(mn[0], mn[1])),
                math.atan2(mn[1], mn[0]))
     b0 = np.zeros(3) if gyro_bias0 is None else _check("gyro_bias0", [gyro_bias0], 1)[0]
     a = _algorithm(algorithm)
