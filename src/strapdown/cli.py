@@ -312,11 +312,84 @@ def _cmd_sweep(args) -> int:
     return 0
 
 
+def _add_ahrs(sub) -> None:
+    p = sub.add_parser("ahrs", help="attitude and heading from gyro, accelerometer and "
+                       "magnetometer (error-state EKF)",
+                       description="Run the AHRS filter over a recording (BROAD .mat or CSV "
+                       "with t,gx,gy,gz,ax,ay,az[,mx,my,mz]) and write t,qw,qx,qy,qz (q_n_b) and "
+                       "the gyro bias, plus OUT.meta.json. Without magnetometer columns heading "
+                       "is not observed (said on stderr and in the metadata).")
+    p.add_argument("--imu", required=True, help="recording (.mat BROAD, .csv)")
+    p.add_argument("--out", required=True, help="output .csv or .npz")
+    p.add_argument("--algorithm", default="rate-single",
+                   help="attitude propagation: rate-single (default), rate-three, "
+                   "rate-three:structure=sliding, rk4, rotvec:N=3, ...")
+    p.add_argument("--frame", choices=["ENU", "NED"], default="ENU")
+    p.add_argument("--gyro-units", choices=["rad/s", "deg/s"], default="rad/s")
+    p.add_argument("--acc-units", choices=["m/s2", "g"], default="m/s2")
+    p.add_argument("--columns", default=",".join(
+        ("t", "gx", "gy", "gz", "ax", "ay", "az", "mx", "my", "mz")),
+        help="CSV columns: time, gyro xyz, accelerometer xyz[, magnetometer xyz]")
+    p.add_argument("--no-mag", action="store_true", help="ignore the magnetometer")
+    p.add_argument("--no-gating", action="store_true",
+                   help="accept every measurement (no innovation gating or disturbance checks)")
+    p.add_argument("--declination-deg", type=float, default=0.0)
+
+
+def _cmd_ahrs(args) -> int:
+    from strapdown.ahrs import AhrsConfig
+    from strapdown.ahrs_log import run_ahrs
+
+    cfg = AhrsConfig(gating=not args.no_gating, declination_deg=args.declination_deg)
+    cols = tuple(c.strip() for c in args.columns.split(","))
+    import warnings
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        res, meta = run_ahrs(args.imu, args.out, algorithm=args.algorithm, frame=args.frame,
+                             config=cfg, gyro_units=args.gyro_units, acc_units=args.acc_units,
+                             columns=cols, use_magnetometer=not args.no_mag)
+    for w in caught:
+        print(f"warning: {w.message}", file=sys.stderr)
+    if not res.heading_observed:
+        print("warning: no magnetometer: heading is not observed (gyro integral from yaw 0)",
+              file=sys.stderr)
+    print(f"wrote {args.out} ({meta['outputs']} attitudes, q_n_b with n = {args.frame}; "
+          f"accelerometer used {meta['accelerometer_used']:.0%}, magnetometer "
+          f"{meta['magnetometer_used']:.0%}) and {args.out}.meta.json")
+    return 0
+
+
+def _add_benchmark_ahrs(sub) -> None:
+    p = sub.add_parser("benchmark-ahrs", help="our EKF against VQF and Fusion on BROAD trials",
+                       description="Run strapdown's EKF (with and without gating) and the "
+                       "open peers VQF and Fusion (pip install 'strapdown[bench]') on every "
+                       "BROAD trial in DIR; write one table and one bar chart.")
+    p.add_argument("dir", help="directory of BROAD .mat trials")
+    p.add_argument("--out", default="reports/benchmark-ahrs", help="output directory")
+    p.add_argument("--algorithm", default="rate-single", help="our propagation algorithm")
+
+
+def _cmd_benchmark_ahrs(args) -> int:
+    from strapdown.ahrs_benchmark import benchmark, mean_total
+
+    res = benchmark(args.dir, args.out, algorithm=args.algorithm,
+                    progress=lambda msg: print(msg, file=sys.stderr))
+    for f in ("strapdown EKF", "strapdown EKF, no gating", "VQF", "Fusion"):
+        m = mean_total(res, f)
+        if m == m:
+            print(f"{f:28s} mean total RMSE {m:.3f}°")
+    print(f"wrote {args.out}/report.md")
+    return 0
+
+
 def _add_reproduce(sub) -> None:
     p = sub.add_parser("reproduce", help="reproduce a paper's tables and figures")
-    p.add_argument("paper", choices=["li2017", "wang-rate", "plaksiy2024", "zhang2021"],
+    p.add_argument("paper", choices=["li2017", "wang-rate", "wang-sliding", "plaksiy2024",
+                                     "zhang2021"],
                    help="li2017: Li & Zhang 2017; wang-rate: the rate-input algorithms of "
-                   "Wang, Wang & Wang (seed 001); plaksiy2024: Plaksiy's Krylov-model study; "
+                   "Wang, Wang & Wang (seed 001); wang-sliding: their three-filter EKF "
+                   "comparison on the loiter flight; plaksiy2024: Plaksiy's Krylov-model study; "
                    "zhang2021: Zhang & Yu's cone angles")
     p.add_argument("--out", required=True, help="output directory (created; files replaced)")
 
@@ -367,10 +440,10 @@ def _cmd_evaluate(args) -> int:
 
 
 def _cmd_reproduce(args) -> int:
-    from strapdown.reproduce import li2017, plaksiy2024, wang_rate, zhang2021
+    from strapdown.reproduce import li2017, plaksiy2024, wang_rate, wang_sliding, zhang2021
 
-    module = {"li2017": li2017, "wang-rate": wang_rate, "plaksiy2024": plaksiy2024,
-              "zhang2021": zhang2021}[args.paper]
+    module = {"li2017": li2017, "wang-rate": wang_rate, "wang-sliding": wang_sliding,
+              "plaksiy2024": plaksiy2024, "zhang2021": zhang2021}[args.paper]
     path = module.reproduce(args.out, progress=lambda msg: print(msg, file=sys.stderr))
     print(f"wrote {path}")
     return 0
@@ -389,6 +462,8 @@ def build_parser() -> argparse.ArgumentParser:
     _add_run(sub)
     _add_compare(sub)
     _add_sweep(sub)
+    _add_ahrs(sub)
+    _add_benchmark_ahrs(sub)
     _add_reproduce(sub)
     b = sub.add_parser("bench", help="throughput benchmarks (ratios to a NumPy pass, peers)",
                        add_help=False)
@@ -407,7 +482,8 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     handlers = {"evaluate": _cmd_evaluate, "coefficients": _cmd_coefficients,
                 "reproduce": _cmd_reproduce, "export-c": _cmd_export, "run": _cmd_run,
-                "compare": _cmd_compare, "sweep": _cmd_sweep}
+                "compare": _cmd_compare, "sweep": _cmd_sweep, "ahrs": _cmd_ahrs,
+                "benchmark-ahrs": _cmd_benchmark_ahrs}
     try:
         return handlers[args.command](args)
     except ValueError as exc:
