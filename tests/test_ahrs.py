@@ -1,0 +1,247 @@
+"""AHRS EKF: kernel against its plain execution, exact simulated truth, gating, frames, input."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import strapdown._ahrs_kernel as K
+from strapdown.ahrs import Q_NED_ENU, AhrsConfig, attitude_from_acc_mag, ekf
+from strapdown.broad import broad_errors
+from strapdown.motions import SpinConing
+from strapdown.rotation.dcm import dcm_from_quat
+from strapdown.rotation.error import attitude_error_angle
+from strapdown.rotation.quaternion import quat_multiply
+
+BROAD = Path(__file__).resolve().parents[2] / "shared" / "data" / "broad"
+ALGS = ["rate-single", "rate-three", "rate-three:structure=sliding", "rk4", "rotvec:N=3"]
+G_UP = np.array([0.0, 0.0, 9.80665])
+M_N = np.array([0.0, 20.0, -40.0])
+
+
+def _imu(motion, t, bias=(0.0, 0.0, 0.0)):
+    q = motion.attitude(t)
+    c = dcm_from_quat(q)
+    acc = np.einsum("nji,j->ni", c, G_UP)
+    mag = np.einsum("nji,j->ni", c, M_N)
+    return q, motion.rate(t) + np.asarray(bias), acc, mag
+
+
+def _motion():
+    return SpinConing(math.radians(20.0), 2 * math.pi * 0.3, math.radians(30.0))
+
+
+@pytest.mark.parametrize("alg", ALGS)
+def test_kernel_matches_its_plain_python_execution(alg, monkeypatch):
+    h = 0.01
+    t = np.arange(120) * h
+    q, w, acc, mag = _imu(_motion(), t, bias=(0.01, -0.02, 0.005))
+    fast = ekf(t, w, acc, mag, algorithm=alg, q0=q[0])
+    monkeypatch.setattr(K, "ekf_kernel", K.ekf_kernel.py_func)
+    slow = ekf(t, w, acc, mag, algorithm=alg, q0=q[0])
+    assert np.array_equal(fast.index, slow.index) and np.array_equal(fast.flags, slow.flags)
+    assert np.allclose(fast.q, slow.q, rtol=0, atol=1e-13)
+    assert np.allclose(fast.gyro_bias, slow.gyro_bias, rtol=0, atol=1e-13)
+
+
+@pytest.mark.parametrize("alg", ALGS)
+def test_ideal_sensors_track_exact_truth(alg):
+    h = 1 / 200
+    t = np.arange(int(30 / h)) * h
+    m = _motion()
+    q, w, acc, mag = _imu(m, t)
+    r = ekf(t, w, acc, mag, algorithm=alg, q0=q[0], mag_reference=M_N)
+    err = attitude_error_angle(r.q, q[r.index])
+    assert err.max() < 2e-4  # rad; the algorithms' own error at 200 Hz on this motion
+    assert np.abs(r.gyro_bias).max() < 1e-4
+
+
+def test_bias_is_estimated_at_rest_and_then_in_motion():
+    h = 1 / 200
+    t = np.arange(int(60 / h)) * h
+    bias = np.array([0.004, -0.006, 0.003])
+    m = _motion()
+    q, w, acc, mag = _imu(m, t, bias)
+    rest = t < 10  # a resting start, as in BROAD
+    q[rest] = q[0]
+    w[rest] = bias
+    c0 = dcm_from_quat(q[0])
+    acc[rest] = c0.T @ G_UP
+    mag[rest] = c0.T @ M_N
+    shift = np.argmax(~rest)
+    t2 = t[shift:] - t[shift]
+    q2, w2, _, _ = _imu(m, t2, bias)
+    rot = quat_multiply(q[0], np.array([1.0, 0, 0, 0]))
+    q[~rest] = quat_multiply(rot, quat_multiply(np.array([q2[0][0], -q2[0][1], -q2[0][2],
+                                                          -q2[0][3]]), q2))
+    c = dcm_from_quat(q[~rest])
+    acc[~rest] = np.einsum("nji,j->ni", c, G_UP)
+    mag[~rest] = np.einsum("nji,j->ni", c, M_N)
+    w[~rest] = w2
+    r = ekf(t, w, acc, mag)
+    at_10 = np.searchsorted(t[r.index], 9.9)
+    assert np.allclose(r.gyro_bias[at_10], bias, atol=2e-4)  # zero-rate updates at rest
+    assert r.fraction(K.F_REST) > 0.1
+    err = attitude_error_angle(r.q, q[r.index])
+    assert err[t[r.index] > 1].max() < math.radians(0.5)
+
+
+def test_magnetic_anomaly_is_rejected_and_heading_recovers():
+    from strapdown import sensors
+
+    h = 1 / 100
+    t = np.arange(int(80 / h)) * h
+    m = _motion()
+    q, w, acc, _ = _imu(m, t)
+    errs = sensors.MagnetometerErrors(white_noise=0.2, anomaly=[15.0, -10.0, 5.0],
+                                      anomaly_start=20.0, anomaly_stop=40.0)
+    mag = sensors.magnetometer(t, q, M_N, errors=errs, rng=3)
+    gated = ekf(t, w, acc, mag, q0=q[0], mag_reference=M_N)
+    open_ = ekf(t, w, acc, mag, q0=q[0], mag_reference=M_N, config=AhrsConfig(gating=False))
+    during = (t[gated.index] > 20) & (t[gated.index] < 40)
+    e_g = attitude_error_angle(gated.q, q[gated.index])
+    e_o = attitude_error_angle(open_.q, q[open_.index])
+    assert np.mean((gated.flags[during] & K.F_MAG_USED) > 0) < 0.05  # rejected
+    assert e_g[during].max() < 0.2 * e_o[during].max()
+    after = t[gated.index] > 45
+    assert np.mean((gated.flags[after] & K.F_MAG_USED) > 0) > 0.95  # used again
+    assert e_g[after].max() < math.radians(1.0)
+
+
+def test_no_magnetometer_degraded_mode():
+    h = 1 / 200
+    t = np.arange(int(20 / h)) * h
+    q, w, acc, _ = _imu(_motion(), t)
+    r = ekf(t, w, acc, None, q0=q[0])
+    assert not r.heading_observed
+    assert not np.any(r.flags & K.F_MAG_USED)
+    # tilt still comes from the accelerometer: the attitude stays within the gyro's accuracy
+    assert attitude_error_angle(r.q, q[r.index]).max() < 1e-3
+
+
+def test_ned_output_is_the_enu_output_rotated():
+    h = 1 / 200
+    t = np.arange(2000) * h
+    q, w, acc, mag = _imu(_motion(), t)
+    enu = ekf(t, w, acc, mag, q0=q[0])
+    q0_ned = quat_multiply(Q_NED_ENU, q[0])
+    ned = ekf(t, w, acc, mag, q0=q0_ned, frame="NED")
+    assert ned.frame == "NED"
+    assert np.allclose(ned.q, quat_multiply(Q_NED_ENU, enu.q), atol=1e-12)
+
+
+@pytest.mark.parametrize("decl", [0.0, 12.5, -40.0])
+def test_attitude_from_acc_mag_recovers_a_known_attitude(decl):
+    rng = np.random.default_rng(5)
+    from strapdown.rotation.quaternion import quat_canonical
+
+    field = np.array([math.sin(math.radians(decl)), math.cos(math.radians(decl)), -1.7])
+    for _ in range(20):
+        qt = rng.standard_normal(4)
+        qt /= np.linalg.norm(qt)
+        c = dcm_from_quat(qt)
+        got = attitude_from_acc_mag(c.T @ G_UP, c.T @ field, declination_deg=decl)
+        assert np.allclose(quat_canonical(got), quat_canonical(qt), atol=1e-12)
+
+
+def test_bad_input_names_the_problem():
+    t = np.arange(100) * 0.01
+    w = np.zeros((100, 3))
+    acc = np.tile(G_UP, (100, 1))
+    mag = np.tile(M_N, (100, 1))
+    bad = acc.copy()
+    bad[37, 1] = np.nan
+    with pytest.raises(ValueError, match="acc has NaN or infinity in row 37"):
+        ekf(t, w, bad, mag)
+    with pytest.raises(ValueError, match=r"median norm is 1; expected about 9\.80665"):
+        ekf(t, w, acc / 9.80665, mag)
+    with pytest.raises(ValueError, match=r"mag must have shape \(100, 3\)"):
+        ekf(t, w, acc, mag[:50])
+    with pytest.raises(ValueError, match="rotvek"):
+        ekf(t, w, acc, mag, algorithm="rotvek")
+    with pytest.raises(ValueError, match=r"AhrsConfig\.acc_noise must be positive"):
+        AhrsConfig(acc_noise=0.0)
+    with pytest.raises(ValueError, match="frame must be 'ENU' or 'NED'"):
+        ekf(t, w, acc, mag, frame="NWU")
+
+
+def test_broad_metric_on_known_errors():
+    rng = np.random.default_rng(2)
+    q = rng.standard_normal((500, 4))
+    q /= np.linalg.norm(q, axis=1, keepdims=True)
+    mv = np.ones(500, bool)
+    assert broad_errors(q, q, mv)["total_deg"] == pytest.approx(0.0, abs=1e-6)
+    yaw = np.array([math.cos(0.3), 0, 0, math.sin(0.3)])  # 34.4° heading offset: removed
+    e = broad_errors(quat_multiply(yaw, q), q, mv)
+    assert e["total_deg"] == pytest.approx(0.0, abs=1e-6)
+    assert e["heading_offset_deg"] == pytest.approx(math.degrees(0.6), abs=1e-9)
+    tilt = np.array([math.cos(0.01), math.sin(0.01), 0, 0])  # 1.146° about east
+    e = broad_errors(quat_multiply(tilt, q), q, mv)
+    assert e["inclination_deg"] == pytest.approx(math.degrees(0.02), rel=1e-9)
+    assert e["heading_deg"] == pytest.approx(0.0, abs=1e-9)
+
+
+@pytest.mark.skipif(not BROAD.is_dir(), reason="shared/data/broad is not beside the checkout")
+def test_broad_acceptance_against_fusion_and_vqf(tmp_path):
+    """Mean total RMSE no worse than Fusion's; gating helps on the magnet trial."""
+    pytest.importorskip("imufusion")
+    pytest.importorskip("vqf")
+    from strapdown.ahrs_benchmark import benchmark, mean_total
+
+    res = benchmark(BROAD, tmp_path / "bench")
+    ours, fusion, vqf = (mean_total(res, f) for f in ("strapdown EKF", "Fusion", "VQF"))
+    assert ours <= fusion
+    assert vqf < fusion  # the peers ran and are sane
+    magnet = "33_disturbed_attached_magnet_2cm"
+    assert (res[(magnet, "strapdown EKF")]["total_deg"]
+            < 0.9 * res[(magnet, "strapdown EKF, no gating")]["total_deg"])
+    assert (tmp_path / "bench" / "errors.png").is_file()
+
+
+def test_cli_ahrs_csv_roundtrip_and_degraded_mode(tmp_path, capsys):
+    from strapdown.cli import main
+
+    h = 0.01
+    t = np.arange(1500) * h
+    q, w, acc, mag = _imu(_motion(), t)
+    rest = slice(0, 60)
+    q[rest], w[rest] = q[0], 0.0
+    acc[rest] = dcm_from_quat(q[0]).T @ G_UP
+    mag[rest] = dcm_from_quat(q[0]).T @ M_N
+    cols = "t,gx,gy,gz,ax,ay,az,mx,my,mz"
+    np.savetxt(tmp_path / "imu.csv", np.column_stack([t, np.degrees(w), acc / 9.80665, mag]),
+               delimiter=",", header=cols, comments="")
+    out = tmp_path / "att.csv"
+    assert main(["ahrs", "--imu", str(tmp_path / "imu.csv"), "--gyro-units", "deg/s",
+                 "--acc-units", "g", "--out", str(out)]) == 0
+    a = np.genfromtxt(out, delimiter=",", names=True)
+    assert a.dtype.names == ("t", "qw", "qx", "qy", "qz", "bias_x", "bias_y", "bias_z")
+    meta = json.loads((tmp_path / "att.csv.meta.json").read_text())
+    assert meta["frame"] == "ENU" and meta["heading_observed"] is True
+    # no magnetometer columns: heading not observed, said so
+    np.savetxt(tmp_path / "nomag.csv", np.column_stack([t, w, acc]), delimiter=",",
+               header="t,gx,gy,gz,ax,ay,az", comments="")
+    assert main(["ahrs", "--imu", str(tmp_path / "nomag.csv"), "--out",
+                 str(tmp_path / "n.npz"), "--frame", "NED"]) == 0
+    assert "heading is not observed" in capsys.readouterr().err
+    meta = json.loads((tmp_path / "n.npz.meta.json").read_text())
+    assert meta["heading_observed"] is False and meta["frame"] == "NED"
+    # gyro in deg/s declared as rad/s: a unit warning (fast spin: 600 °/s → 600 "rad/s")
+    spin = np.column_stack([t, np.tile([0, 0, 600.0], (t.size, 1)), np.tile(G_UP, (t.size, 1))])
+    np.savetxt(tmp_path / "deg.csv", spin, delimiter=",", header="t,gx,gy,gz,ax,ay,az",
+               comments="")
+    main(["ahrs", "--imu", str(tmp_path / "deg.csv"), "--out", str(tmp_path / "d.csv")])
+    assert "more likely in deg/s" in capsys.readouterr().err
+    bad = np.column_stack([t, w, acc])
+    bad[11, 4] = np.nan
+    np.savetxt(tmp_path / "nan.csv", bad, delimiter=",", header="t,gx,gy,gz,ax,ay,az",
+               comments="")
+    with pytest.raises(SystemExit) as exc:
+        main(["ahrs", "--imu", str(tmp_path / "nan.csv"), "--out", str(tmp_path / "x.csv")])
+    assert exc.value.code == 2
+    assert "NaN or infinity in the accelerometer at data row 12" in capsys.readouterr().err
+    assert not (tmp_path / "x.csv").exists()
