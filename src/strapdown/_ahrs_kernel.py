@@ -162,32 +162,161 @@ def _rk4(q, w0, w1, w2, h2, out):
         out[i] /= nrm
 
 
+@njit(cache=True, inline="always")
+def _inverse_sym(S, m, out):
+    """Inverse of a symmetric m × m matrix, m ≤ 3 (explicit cofactors)."""
+    if m == 1:
+        out[0, 0] = 1.0 / S[0, 0]
+    elif m == 2:
+        det = S[0, 0] * S[1, 1] - S[0, 1] * S[1, 0]
+        out[0, 0] = S[1, 1] / det
+        out[1, 1] = S[0, 0] / det
+        out[0, 1] = -S[0, 1] / det
+        out[1, 0] = -S[1, 0] / det
+    else:
+        a, b, c = S[0, 0], S[0, 1], S[0, 2]
+        d, e, f = S[1, 0], S[1, 1], S[1, 2]
+        g, h, k = S[2, 0], S[2, 1], S[2, 2]
+        c00 = e * k - f * h
+        c01 = -(d * k - f * g)
+        c02 = d * h - e * g
+        det = a * c00 + b * c01 + c * c02
+        out[0, 0] = c00 / det
+        out[1, 0] = c01 / det
+        out[2, 0] = c02 / det
+        out[0, 1] = -(b * k - c * h) / det
+        out[1, 1] = (a * k - c * g) / det
+        out[2, 1] = -(a * h - b * g) / det
+        out[0, 2] = (b * f - c * e) / det
+        out[1, 2] = -(a * f - c * d) / det
+        out[2, 2] = (a * e - b * d) / det
+
+
 @njit(cache=True)
 def _joseph(P, H, R, y, gate, gating, force, dx, soft=False):
     """Gated Joseph-form update of P with (H, R, y); returns (NIS, accepted). dx += K y.
 
-    Beyond the gate a hard gate rejects; a soft gate de-weights instead (R scaled by NIS/gate,
-    a Huber-type bounded step).
+    ``P ← (I − KH) P (I − KH)ᵀ + K R Kᵀ``, written out for m ≤ 3 rows without
+    temporaries from BLAS. Beyond the gate a hard gate rejects; a soft gate
+    de-weights instead (R scaled by NIS/gate, a Huber-type bounded step).
     """
     m = y.size
-    PHt = P @ H.T
-    S = H @ PHt + R
-    Sinv = np.linalg.inv(S)
+    n = P.shape[0]
+    PHt = np.empty((n, m))
+    for i in range(n):
+        for j in range(m):
+            acc = 0.0
+            for k in range(n):
+                acc += P[i, k] * H[j, k]
+            PHt[i, j] = acc
+    S = np.empty((m, m))
+    for i in range(m):
+        for j in range(m):
+            acc = R[i, j]
+            for k in range(n):
+                acc += H[i, k] * PHt[k, j]
+            S[i, j] = acc
+    Sinv = np.empty((m, m))
+    _inverse_sym(S, m, Sinv)
     nis = 0.0
     for i in range(m):
         for j in range(m):
             nis += y[i] * Sinv[i, j] * y[j]
+    scale = 1.0
     if gating and nis > gate and not force:
         if not soft:
             return nis, False
-        R = R * (nis / gate)
-        S = H @ PHt + R
-        Sinv = np.linalg.inv(S)
-    K = PHt @ Sinv
-    IKH = np.eye(P.shape[0]) - K @ H
-    P[:, :] = IKH @ P @ IKH.T + K @ R @ K.T
-    dx += K @ y
+        scale = nis / gate
+        for i in range(m):
+            for j in range(m):
+                S[i, j] += (scale - 1.0) * R[i, j]
+        _inverse_sym(S, m, Sinv)
+    K = np.empty((n, m))
+    for i in range(n):
+        for j in range(m):
+            acc = 0.0
+            for k in range(m):
+                acc += PHt[i, k] * Sinv[k, j]
+            K[i, j] = acc
+    # W = (I − KH) P = P − K (HP), HP = PHtᵀ
+    W = np.empty((n, n))
+    for i in range(n):
+        for j in range(n):
+            acc = P[i, j]
+            for k in range(m):
+                acc -= K[i, k] * PHt[j, k]
+            W[i, j] = acc
+    # P = W (I − KH)ᵀ + K R Kᵀ = W − (W Hᵀ) Kᵀ + K R Kᵀ
+    WHt = np.empty((n, m))
+    for i in range(n):
+        for j in range(m):
+            acc = 0.0
+            for k in range(n):
+                acc += W[i, k] * H[j, k]
+            WHt[i, j] = acc
+    KR = np.empty((n, m))
+    for i in range(n):
+        for j in range(m):
+            acc = 0.0
+            for k in range(m):
+                acc += K[i, k] * R[k, j] * scale
+            KR[i, j] = acc
+    for i in range(n):
+        for j in range(n):
+            acc = W[i, j]
+            for k in range(m):
+                acc += (KR[i, k] - WHt[i, k]) * K[j, k]
+            P[i, j] = acc
+    for i in range(n):
+        acc = 0.0
+        for k in range(m):
+            acc += K[i, k] * y[k]
+        dx[i] += acc
     return nis, True
+
+
+@njit(cache=True, inline="always")
+def _sub_hdx(y, H, dx):
+    """y −= H dx."""
+    for i in range(y.size):
+        acc = 0.0
+        for k in range(dx.size):
+            acc += H[i, k] * dx[k]
+        y[i] -= acc
+
+
+@njit(cache=True)
+def _propagate(P, phi, T, decay, qg, qb, qa):
+    """P ← Φ P Φᵀ + Q with Φ = [[exp(−[φ×]), −T I, 0], [0, I, 0], [0, 0, decay I]]."""
+    px, py, pz = phi[0], phi[1], phi[2]
+    # A = I − [φ×] + ½[φ×]²
+    A = np.empty((3, 3))
+    A[0, 0] = 1.0 - 0.5 * (py * py + pz * pz)
+    A[1, 1] = 1.0 - 0.5 * (px * px + pz * pz)
+    A[2, 2] = 1.0 - 0.5 * (px * px + py * py)
+    A[0, 1] = pz + 0.5 * px * py
+    A[1, 0] = -pz + 0.5 * px * py
+    A[0, 2] = -py + 0.5 * px * pz
+    A[2, 0] = py + 0.5 * px * pz
+    A[1, 2] = px + 0.5 * py * pz
+    A[2, 1] = -px + 0.5 * py * pz
+    M = np.empty((9, 9))  # Φ P
+    for c in range(9):
+        for r in range(3):
+            M[r, c] = (A[r, 0] * P[0, c] + A[r, 1] * P[1, c] + A[r, 2] * P[2, c]
+                       - T * P[3 + r, c])
+            M[3 + r, c] = P[3 + r, c]
+            M[6 + r, c] = decay * P[6 + r, c]
+    for r in range(9):  # (Φ P) Φᵀ
+        for c in range(3):
+            P[r, c] = (M[r, 0] * A[c, 0] + M[r, 1] * A[c, 1] + M[r, 2] * A[c, 2]
+                       - T * M[r, 3 + c])
+            P[r, 3 + c] = M[r, 3 + c]
+            P[r, 6 + c] = decay * M[r, 6 + c]
+    for r in range(3):
+        P[r, r] += qg
+        P[3 + r, 3 + r] += qb
+        P[6 + r, 6 + r] += qa
 
 
 @njit(cache=True)
@@ -307,22 +436,10 @@ def ekf_kernel(x, is_rate, h, offsets, weights, pi, pj, pc, stride, span, end_of
                 a2[a] += al * (acc[last, a] * acc[last, a] - a2[a])
         # ---------------- covariance propagation ----------------
         # Φ_θθ = exp(−[φ×]) ≈ I − [φ×] + ½[φ×]², Φ_θb = −T I, Φ_aa = e^{−T/τ} I
-        Phi = np.eye(9)
-        px, py, pz = phi[0], phi[1], phi[2]
-        Sk = np.array([[0.0, -pz, py], [pz, 0.0, -px], [-py, px, 0.0]])
-        Sk2 = Sk @ Sk
-        for r in range(3):
-            for s in range(3):
-                Phi[r, s] += -Sk[r, s] + 0.5 * Sk2[r, s]
-            Phi[r, 3 + r] = -T
-            Phi[6 + r, 6 + r] = np.exp(-T / params[P_SINGER_TAU])
-        Q = np.zeros((9, 9))
-        qa = params[P_SINGER_SIGMA] ** 2 * (1.0 - np.exp(-2.0 * T / params[P_SINGER_TAU]))
-        for r in range(3):
-            Q[r, r] = params[P_GYRO_NOISE] ** 2 * T
-            Q[3 + r, 3 + r] = params[P_BIAS_RW] ** 2 * T
-            Q[6 + r, 6 + r] = qa
-        P = Phi @ P @ Phi.T + Q
+        tau_a = params[P_SINGER_TAU]
+        qa = params[P_SINGER_SIGMA] ** 2 * (1.0 - np.exp(-2.0 * T / tau_a))
+        _propagate(P, phi, T, np.exp(-T / tau_a), params[P_GYRO_NOISE] ** 2 * T,
+                   params[P_BIAS_RW] ** 2 * T, qa)
         # ---------------- measurement updates ----------------
         flags = 0
         dx[:] = 0.0
@@ -369,7 +486,7 @@ def ekf_kernel(x, is_rate, h, offsets, weights, pi, pj, pc, stride, span, end_of
             y = np.empty(2)
             y[0] = lp[0]
             y[1] = lp[1]
-            y -= H @ dx
+            _sub_hdx(y, H, dx)
             R = np.eye(2) * params[P_ACC_LP_NOISE] ** 2 / T
             force = False
             if (gating and acc_quiet and acc_bad_since >= 0.0
@@ -406,7 +523,7 @@ def ekf_kernel(x, is_rate, h, offsets, weights, pi, pj, pc, stride, span, end_of
             y = np.empty(3)
             for a in range(3):
                 y[a] = acc[k, a] - (v[a] + accel[a])
-            y -= H @ dx
+            _sub_hdx(y, H, dx)
             # rotation seen at a lever arm (centripetal + tangential) widens the noise
             kk = min(k, x.shape[0] - 1)
             if is_rate:
@@ -450,7 +567,9 @@ def ekf_kernel(x, is_rate, h, offsets, weights, pi, pj, pc, stride, span, end_of
         if use_mag:
             mb = mag[k]
             nb = np.sqrt(mb[0] ** 2 + mb[1] ** 2 + mb[2] ** 2)
-            mn = C @ mb
+            mn = np.empty(3)
+            for a in range(3):
+                mn[a] = C[a, 0] * mb[0] + C[a, 1] * mb[1] + C[a, 2] * mb[2]
             mh = np.sqrt(mn[0] ** 2 + mn[1] ** 2)
             dip = np.arctan2(-mn[2], mh)
             disturbed = (abs(nb - params[P_REF_NORM]) > params[P_MAG_NORM_TOL] * params[P_REF_NORM]
@@ -467,7 +586,8 @@ def ekf_kernel(x, is_rate, h, offsets, weights, pi, pj, pc, stride, span, end_of
                     H[0, a] = -C[2, a]
                 yv = np.arctan2(mn[1], mn[0]) - params[P_REF_HEADING]
                 yv = (yv + np.pi) % (2.0 * np.pi) - np.pi
-                y = np.array([yv]) - H @ dx
+                y = np.array([yv])
+                _sub_hdx(y, H, dx)
                 R = np.eye(1) * params[P_HEADING_NOISE] ** 2 / T
                 force = False
                 if (gating and mag_bad_since >= 0.0

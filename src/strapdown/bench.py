@@ -7,9 +7,12 @@ along the last axis: a memory-bandwidth floor). Peers, when installed
 (``pip install strapdown[bench]``), do the equivalent per-sample attitude
 update: scipy ``Rotation`` in a Python loop, ``ahrs.filters.AngularRate``
 and ``smsfusion.StrapdownINS.update``; they are timed on fewer samples and
-reported per sample. Peak resident memory (VmHWM) of a 10⁸-sample stream is
-measured in a fresh subprocess; about 140 MB of it is the interpreter with
-numpy, scipy and numba loaded.
+reported per sample. The AHRS EKF (every propagation algorithm, with
+accelerometer and magnetometer updates at every output) runs on
+``ekf_samples`` samples, next to the AHRS peers VQF (offline, C++) and Fusion
+(per-sample Python calls into C) on the same data. Peak resident memory
+(VmHWM) of a 10⁸-sample stream is measured in a fresh subprocess; about
+140 MB of it is the interpreter with numpy, scipy and numba loaded.
 """
 
 from __future__ import annotations
@@ -73,6 +76,60 @@ def _ours(samples, repeat):
         recs.append({"name": name, "samples_per_s": r, "ratio_to_numpy_pass": r / floor,
                      "peer": None})
     return recs, floor
+
+
+def _imu(samples):
+    """A smooth IMU record with gravity and field: spin + coning at 200 Hz."""
+    import math
+
+    from strapdown.motions import SpinConing
+    from strapdown.rotation.dcm import dcm_from_quat
+
+    t = np.arange(samples) / 200.0
+    m = SpinConing(math.radians(10.0), 2 * math.pi * 0.5, math.radians(20.0))
+    c = dcm_from_quat(m.attitude(t))
+    acc = np.einsum("nji,j->ni", c, [0.0, 0.0, 9.80665])
+    mag = np.einsum("nji,j->ni", c, [0.0, 20.0, -40.0])
+    return t, m.rate(t), acc, mag
+
+
+def _ahrs(samples, floor, repeat):
+    from strapdown.ahrs import ekf
+
+    t, w, acc, mag = _imu(samples)
+    recs = []
+    for alg in ("rate-single", "rate-three", "rate-three:structure=sliding", "rk4",
+                "rotvec:N=3"):
+        r = samples / _best(lambda alg=alg: ekf(t, w, acc, mag, algorithm=alg), repeat)
+        name = "ahrs-ekf-" + alg.replace(":structure=", "-").replace(":N=", "-N")
+        recs.append({"name": name, "samples_per_s": r, "ratio_to_numpy_pass": r / floor,
+                     "peer": None})
+    try:
+        import vqf
+
+        r = samples / _best(lambda: vqf.offlineVQF(w, acc, mag, 1 / 200.0, {}), repeat)
+        recs.append({"name": "vqf-offline-9d", "samples_per_s": r,
+                     "ratio_to_numpy_pass": r / floor, "peer": "vqf"})
+    except ImportError:
+        pass
+    try:
+        import imufusion
+
+        few = min(samples, 50_000)
+
+        def fusion():
+            a = imufusion.Ahrs()
+            a.set_sample_period(1 / 200.0)
+            g, ag = np.degrees(w[:few]), acc[:few] / 9.80665
+            for i in range(few):
+                a.update(g[i], ag[i], mag[i])
+
+        r = few / _best(fusion, 1)
+        recs.append({"name": "imufusion-ahrs", "samples_per_s": r,
+                     "ratio_to_numpy_pass": r / floor, "peer": "imufusion"})
+    except ImportError:
+        pass
+    return recs
 
 
 def _peers(samples, floor):
@@ -152,10 +209,12 @@ def _stream_memory(total, structure, chunk=1 << 16):
 
 
 def run_benchmarks(samples: int = 10_000_000, peer_samples: int = 20_000, repeat: int = 3,
-                   stream_samples: int = 100_000_000) -> list[dict]:
+                   stream_samples: int = 100_000_000, ekf_samples: int = 1_000_000) -> list[dict]:
     """All benchmark records (see the module docstring)."""
     recs, floor = _ours(samples, repeat)
     recs += _peers(peer_samples, floor)
+    if ekf_samples:
+        recs += _ahrs(ekf_samples, floor, repeat)
     if stream_samples:
         for structure in ("conventional", "realtime"):
             recs.append(_stream_memory(stream_samples, structure))
@@ -170,10 +229,12 @@ def main(argv=None) -> int:
     p.add_argument("--peer-samples", type=int, default=20_000)
     p.add_argument("--stream-samples", type=int, default=100_000_000,
                    help="0 skips the streaming memory test")
+    p.add_argument("--ekf-samples", type=int, default=1_000_000,
+                   help="samples for the AHRS EKF and its peers (0 skips them)")
     p.add_argument("--repeat", type=int, default=3)
     p.add_argument("--json", action="store_true")
     a = p.parse_args(argv)
-    recs = run_benchmarks(a.samples, a.peer_samples, a.repeat, a.stream_samples)
+    recs = run_benchmarks(a.samples, a.peer_samples, a.repeat, a.stream_samples, a.ekf_samples)
     if a.json:
         print(json.dumps(recs, indent=2))
         return 0
