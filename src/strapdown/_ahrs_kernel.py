@@ -193,7 +193,7 @@ def _inverse_sym(S, m, out):
 
 
 @njit(cache=True)
-def _joseph(P, H, R, y, gate, gating, force, dx, soft=False):
+def _joseph(P, H, R, y, gate, gating, force, dx, soft, wk):
     """Gated Joseph-form update of P with (H, R, y); returns (NIS, accepted). dx += K y.
 
     ``P ← (I − KH) P (I − KH)ᵀ + K R Kᵀ``, written out for m ≤ 3 rows without
@@ -202,21 +202,25 @@ def _joseph(P, H, R, y, gate, gating, force, dx, soft=False):
     """
     m = y.size
     n = P.shape[0]
-    PHt = np.empty((n, m))
+    PHt = wk[0][:, :m]
+    K = wk[1][:, :m]
+    WHt = wk[2][:, :m]
+    KR = wk[3][:, :m]
+    W = wk[4]
+    S = wk[5][:m, :m]
+    Sinv = wk[6][:m, :m]
     for i in range(n):
         for j in range(m):
             acc = 0.0
             for k in range(n):
                 acc += P[i, k] * H[j, k]
             PHt[i, j] = acc
-    S = np.empty((m, m))
     for i in range(m):
         for j in range(m):
             acc = R[i, j]
             for k in range(n):
                 acc += H[i, k] * PHt[k, j]
             S[i, j] = acc
-    Sinv = np.empty((m, m))
     _inverse_sym(S, m, Sinv)
     nis = 0.0
     for i in range(m):
@@ -231,7 +235,6 @@ def _joseph(P, H, R, y, gate, gating, force, dx, soft=False):
             for j in range(m):
                 S[i, j] += (scale - 1.0) * R[i, j]
         _inverse_sym(S, m, Sinv)
-    K = np.empty((n, m))
     for i in range(n):
         for j in range(m):
             acc = 0.0
@@ -239,7 +242,6 @@ def _joseph(P, H, R, y, gate, gating, force, dx, soft=False):
                 acc += PHt[i, k] * Sinv[k, j]
             K[i, j] = acc
     # W = (I − KH) P = P − K (HP), HP = PHtᵀ
-    W = np.empty((n, n))
     for i in range(n):
         for j in range(n):
             acc = P[i, j]
@@ -247,14 +249,12 @@ def _joseph(P, H, R, y, gate, gating, force, dx, soft=False):
                 acc -= K[i, k] * PHt[j, k]
             W[i, j] = acc
     # P = W (I − KH)ᵀ + K R Kᵀ = W − (W Hᵀ) Kᵀ + K R Kᵀ
-    WHt = np.empty((n, m))
     for i in range(n):
         for j in range(m):
             acc = 0.0
             for k in range(n):
                 acc += W[i, k] * H[j, k]
             WHt[i, j] = acc
-    KR = np.empty((n, m))
     for i in range(n):
         for j in range(m):
             acc = 0.0
@@ -353,6 +353,8 @@ def ekf_kernel(x, is_rate, h, offsets, weights, pi, pj, pc, stride, span, end_of
     dx = np.zeros(9)
     eps = np.empty(3)
     bias_x = np.empty(3)
+    wk = (np.empty((9, 3)), np.empty((9, 3)), np.empty((9, 3)), np.empty((9, 3)),
+          np.empty((9, 9)), np.empty((3, 3)), np.empty((3, 3)))
     # rest detector (exponential moving averages of gyro and accelerometer)
     gm = np.zeros(3)
     g2 = np.zeros(3)
@@ -464,7 +466,7 @@ def ekf_kernel(x, is_rate, h, offsets, weights, pi, pj, pc, stride, span, end_of
                     H[a, 3 + a] = 1.0
                 R = np.eye(3) * params[P_REST_NOISE] ** 2 / T
                 y = gm - (bias + dx[3:6])
-                _joseph(P, H, R, y, 0.0, False, True, dx)
+                _joseph(P, H, R, y, 0.0, False, True, dx, False, wk)
                 flags |= F_REST
         nis_acc = np.nan
         if use_acc and lp_tau > 0.0:
@@ -497,7 +499,7 @@ def ekf_kernel(x, is_rate, h, offsets, weights, pi, pj, pc, stride, span, end_of
                 force = True
                 flags |= F_ACC_RECOVERED
             nis_acc, ok = _joseph(P, H, R, y, params[P_ACC_GATE_LP], gating, force, dx,
-                                  params[P_SOFT_ACC] != 0.0)
+                                  params[P_SOFT_ACC] != 0.0, wk)
             if ok:
                 flags |= F_ACC_USED
                 acc_bad_since = -1.0
@@ -555,7 +557,7 @@ def ekf_kernel(x, is_rate, h, offsets, weights, pi, pj, pc, stride, span, end_of
                 flags |= F_ACC_DISTURBED
             else:
                 nis_acc, ok = _joseph(P, H, R, y, params[P_ACC_GATE], gating, force, dx,
-                                      params[P_SOFT_ACC] != 0.0)
+                                      params[P_SOFT_ACC] != 0.0, wk)
                 if ok:
                     flags |= F_ACC_USED
                     acc_bad_since = -1.0
@@ -598,7 +600,7 @@ def ekf_kernel(x, is_rate, h, offsets, weights, pi, pj, pc, stride, span, end_of
                             P[r, s] += ra * C[2, r] * C[2, s]
                     force = True
                     flags |= F_MAG_RECOVERED
-                nis_mag, ok = _joseph(P, H, R, y, params[P_MAG_GATE], gating, force, dx)
+                nis_mag, ok = _joseph(P, H, R, y, params[P_MAG_GATE], gating, force, dx, False, wk)
                 if ok:
                     flags |= F_MAG_USED
                     mag_bad_since = -1.0
