@@ -5,6 +5,9 @@ Runs, on every BROAD trial (``*.mat``) in a directory and in the same run:
 - ``strapdown EKF`` — :func:`strapdown.ahrs.ekf` with its defaults;
 - ``strapdown EKF, no gating`` — the same with innovation gating and
   magnetic-disturbance rejection off (what the gating buys);
+- ``strapdown EKF, raw acc`` (and ``, no gating``) — the paper's
+  accelerometer model (every sample, Singer manoeuvre state) instead of the
+  default low-passed reference-frame model;
 - ``VQF`` — Laidig & Seel's VQF (package ``vqf``, offline 9D);
 - ``Fusion`` — x-io's Fusion AHRS (package ``imufusion``) with its
   documented example settings (gain 0.5, acceleration and magnetic rejection
@@ -33,7 +36,11 @@ from strapdown.broad import BroadTrial, broad_errors, read_broad
 
 __all__ = ["FILTERS", "benchmark", "run_filter"]
 
-FILTERS = ("strapdown EKF", "strapdown EKF, no gating", "VQF", "Fusion")
+FILTERS = ("strapdown EKF", "strapdown EKF, no gating", "strapdown EKF, raw acc",
+           "strapdown EKF, raw acc, no gating", "VQF", "Fusion")
+_OURS = {"strapdown EKF": {}, "strapdown EKF, no gating": {"gating": False},
+         "strapdown EKF, raw acc": {"acc_model": "raw"},
+         "strapdown EKF, raw acc, no gating": {"acc_model": "raw", "gating": False}}
 
 
 def _vqf(tr: BroadTrial) -> np.ndarray:
@@ -74,12 +81,9 @@ def _fusion(tr: BroadTrial) -> np.ndarray:
 
 def run_filter(name: str, tr: BroadTrial, *, algorithm: str = "rate-single"):
     """``(q at every sample index it outputs, indices)`` for one filter on one trial."""
-    if name == "strapdown EKF":
-        r = ekf(tr.t, tr.gyro, tr.acc, tr.mag, algorithm=algorithm)
-        return r.q, r.index
-    if name == "strapdown EKF, no gating":
+    if name in _OURS:
         r = ekf(tr.t, tr.gyro, tr.acc, tr.mag, algorithm=algorithm,
-                config=AhrsConfig(gating=False))
+                config=AhrsConfig(**_OURS[name]))
         return r.q, r.index
     idx = np.arange(tr.t.size)
     if name == "VQF":
@@ -146,15 +150,24 @@ def benchmark(directory, out, *, algorithm: str = "rate-single",
     md.append("\n## Mean over the trials\n\n")
     md.append(w.table("summary", ["filter", "mean total RMSE (°)", "range (°)"], summary))
     disturbed = [n for n in names if "disturbed" in n and "undisturbed" not in n]
-    if "strapdown EKF, no gating" in ran and disturbed:
+    if disturbed:
         lines = []
         for n in disturbed:
-            a = results[(n, "strapdown EKF")]["total_deg"]
-            b = results[(n, "strapdown EKF, no gating")]["total_deg"]
-            lines.append(f"- {n}: {a:.3f}° with gating, {b:.3f}° without "
-                         f"({(b - a) / b * 100:+.1f} % by gating)")
+            for model, on, off in (("low-pass model", "strapdown EKF",
+                                    "strapdown EKF, no gating"),
+                                   ("raw model", "strapdown EKF, raw acc",
+                                    "strapdown EKF, raw acc, no gating")):
+                a = results[(n, on)]["total_deg"]
+                b = results[(n, off)]["total_deg"]
+                lines.append(f"- {n}, {model}: {a:.3f}° with gating, {b:.3f}° without "
+                             f"(gating changes the error by {(a - b) / b * 100:+.1f} %)")
         md.append("\n## What the gating does on the disturbed trials\n\n" + "\n".join(lines)
-                  + "\n")
+                  + "\n\nTapping disturbs the accelerometer with short spikes. The default model "
+                  "averages the specific force in the reference frame over seconds, so the taps "
+                  "are already averaged out and gating has little left to do; the paper's raw "
+                  "model takes every sample and needs the gate. The attached magnet disturbs "
+                  "the magnetometer for a minute at a time: the norm/dip checks and the heading "
+                  "gate keep it out of the heading.\n")
     fig, ax = plt.subplots(figsize=(9, 4))
     width = 0.8 / max(len(ran), 1)
     x = np.arange(len(names))

@@ -375,10 +375,12 @@ def _cmd_benchmark_ahrs(args) -> int:
 
     res = benchmark(args.dir, args.out, algorithm=args.algorithm,
                     progress=lambda msg: print(msg, file=sys.stderr))
-    for f in ("strapdown EKF", "strapdown EKF, no gating", "VQF", "Fusion"):
+    from strapdown.ahrs_benchmark import FILTERS
+
+    for f in FILTERS:
         m = mean_total(res, f)
         if m == m:
-            print(f"{f:28s} mean total RMSE {m:.3f}°")
+            print(f"{f:34s} mean total RMSE {m:.3f}°")
     print(f"wrote {args.out}/report.md")
     return 0
 
