@@ -32,7 +32,7 @@ test: $(DEVSTAMP)
 ## bench: throughput benchmarks with peers (numbers are reported, never asserted)
 bench: $(STAMP)
 	$(PY) -m pip install --quiet -e ".[bench]"
-	$(VENV)/bin/strapdown bench
+	$(PY) benchmarks/run.py --out reports/bench.json
 
 ## lint: ruff
 lint: $(DEVSTAMP)
