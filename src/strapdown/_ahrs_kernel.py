@@ -192,6 +192,17 @@ def _inverse_sym(S, m, out):
         out[2, 2] = (a * e - b * d) / det
 
 
+@njit(cache=True, inline="always")
+def _mul_bt(X, H, out):
+    """out = X Hᵀ (X: n × k, H: m × k)."""
+    for i in range(X.shape[0]):
+        for j in range(H.shape[0]):
+            acc = 0.0
+            for k in range(X.shape[1]):
+                acc += X[i, k] * H[j, k]
+            out[i, j] = acc
+
+
 @njit(cache=True)
 def _joseph(P, H, R, y, gate, gating, force, dx, soft, wk):
     """Gated Joseph-form update of P with (H, R, y); returns (NIS, accepted). dx += K y.
@@ -209,12 +220,7 @@ def _joseph(P, H, R, y, gate, gating, force, dx, soft, wk):
     W = wk[4]
     S = wk[5][:m, :m]
     Sinv = wk[6][:m, :m]
-    for i in range(n):
-        for j in range(m):
-            acc = 0.0
-            for k in range(n):
-                acc += P[i, k] * H[j, k]
-            PHt[i, j] = acc
+    _mul_bt(P, H, PHt)
     for i in range(m):
         for j in range(m):
             acc = R[i, j]
@@ -249,12 +255,7 @@ def _joseph(P, H, R, y, gate, gating, force, dx, soft, wk):
                 acc -= K[i, k] * PHt[j, k]
             W[i, j] = acc
     # P = W (I − KH)ᵀ + K R Kᵀ = W − (W Hᵀ) Kᵀ + K R Kᵀ
-    for i in range(n):
-        for j in range(m):
-            acc = 0.0
-            for k in range(n):
-                acc += W[i, k] * H[j, k]
-            WHt[i, j] = acc
+    _mul_bt(W, H, WHt)
     for i in range(n):
         for j in range(m):
             acc = 0.0
