@@ -245,3 +245,28 @@ def test_cli_ahrs_csv_roundtrip_and_degraded_mode(tmp_path, capsys):
     assert exc.value.code == 2
     assert "NaN or infinity in the accelerometer at data row 12" in capsys.readouterr().err
     assert not (tmp_path / "x.csv").exists()
+
+
+def test_accelerometer_bias_state(monkeypatch):
+    """12 states: the raw model recovers a constant accelerometer bias under rotation."""
+    m = SpinConing(math.radians(30.0), 2 * math.pi * 0.2, math.radians(20.0))
+    h = 1 / 200
+    t = np.arange(int(120 / h)) * h
+    q, w, acc, mag = _imu(m, t)
+    ba = np.array([0.15, -0.1, 0.2])
+    cfg = AhrsConfig(acc_model="raw", singer_sigma=1e-3, estimate_acc_bias=True)
+    r = ekf(t, w, acc + ba, mag, q0=q[0], mag_reference=M_N, config=cfg)
+    assert np.allclose(r.acc_bias[-1], ba, atol=0.01)
+    late = t[r.index] > 60
+    assert attitude_error_angle(r.q, q[r.index])[late].max() < math.radians(0.2)
+    off = ekf(t, w, acc + ba, mag, q0=q[0], mag_reference=M_N,
+              config=AhrsConfig(acc_model="raw", singer_sigma=1e-3))
+    assert off.acc_bias is None
+    assert attitude_error_angle(off.q, q[off.index])[late].max() > math.radians(1.0)
+    # the 12-state kernel against its plain execution
+    short = slice(0, 150)
+    fast = ekf(t[short], w[short], acc[short] + ba, mag[short], q0=q[0], config=cfg)
+    monkeypatch.setattr(K, "ekf_kernel", K.ekf_kernel.py_func)
+    slow = ekf(t[short], w[short], acc[short] + ba, mag[short], q0=q[0], config=cfg)
+    assert np.allclose(fast.q, slow.q, rtol=0, atol=1e-13)
+    assert np.allclose(fast.acc_bias, slow.acc_bias, rtol=0, atol=1e-13)

@@ -15,7 +15,8 @@ Measurement noises are densities: an update every ``T`` seconds uses
 propagation algorithm's update period.
 
 Frames: ENU reference; ``q`` is q_n_b (Hamilton, scalar first). Error state
-``x = [δθ_b, δb_g, a_b]`` with ``q_true = q̂ ⊗ q(δθ_b)``.
+``x = [δθ_b, δb_g, a_b]`` (``+ δb_a``, the accelerometer bias, when ``P0`` is
+12 × 12) with ``q_true = q̂ ⊗ q(δθ_b)``.
 """
 
 from __future__ import annotations
@@ -58,7 +59,8 @@ P_LEVER = 28
 P_ACC_LP_TAU = 29
 P_ACC_LP_NOISE = 30
 P_ACC_GATE_LP = 31
-N_PARAMS = 32
+P_ACC_BIAS_RW = 32
+N_PARAMS = 33
 
 # flags per output
 F_ACC_USED = 1
@@ -287,8 +289,9 @@ def _sub_hdx(y, H, dx):
 
 
 @njit(cache=True)
-def _propagate(P, phi, T, decay, qg, qb, qa):
-    """P ← Φ P Φᵀ + Q with Φ = [[exp(−[φ×]), −T I, 0], [0, I, 0], [0, 0, decay I]]."""
+def _propagate(P, phi, T, decay, qg, qb, qa, qab):
+    """P ← Φ P Φᵀ + Q with Φ = [[exp(−[φ×]), −T I, 0], [0, I, 0], [0, 0, decay I]]
+    (and an identity block for an accelerometer bias when P is 12 × 12)."""
     px, py, pz = phi[0], phi[1], phi[2]
     # A = I − [φ×] + ½[φ×]²
     A = np.empty((3, 3))
@@ -301,29 +304,36 @@ def _propagate(P, phi, T, decay, qg, qb, qa):
     A[2, 0] = py + 0.5 * px * pz
     A[1, 2] = px + 0.5 * py * pz
     A[2, 1] = -px + 0.5 * py * pz
-    M = np.empty((9, 9))  # Φ P
-    for c in range(9):
+    nx = P.shape[0]
+    M = np.empty((nx, nx))  # Φ P
+    for c in range(nx):
         for r in range(3):
             M[r, c] = (A[r, 0] * P[0, c] + A[r, 1] * P[1, c] + A[r, 2] * P[2, c]
                        - T * P[3 + r, c])
             M[3 + r, c] = P[3 + r, c]
             M[6 + r, c] = decay * P[6 + r, c]
-    for r in range(9):  # (Φ P) Φᵀ
+            if nx > 9:
+                M[9 + r, c] = P[9 + r, c]
+    for r in range(nx):  # (Φ P) Φᵀ
         for c in range(3):
             P[r, c] = (M[r, 0] * A[c, 0] + M[r, 1] * A[c, 1] + M[r, 2] * A[c, 2]
                        - T * M[r, 3 + c])
             P[r, 3 + c] = M[r, 3 + c]
             P[r, 6 + c] = decay * M[r, 6 + c]
+            if nx > 9:
+                P[r, 9 + c] = M[r, 9 + c]
     for r in range(3):
         P[r, r] += qg
         P[3 + r, 3 + r] += qb
         P[6 + r, 6 + r] += qa
+        if nx > 9:
+            P[9 + r, 9 + r] += qab
 
 
 @njit(cache=True)
 def ekf_kernel(x, is_rate, h, offsets, weights, pi, pj, pc, stride, span, end_off, lag,
                start_c, rk4, acc, mag, params, q0, b0, P0,
-               out_q, out_b, out_a, out_idx, out_flags, out_nis, out_sig):
+               out_q, out_b, out_a, out_ab, out_idx, out_flags, out_nis, out_sig):
     """Run the filter; returns the number of outputs written.
 
     ``x``: rates (n, 3) if ``is_rate`` else increments (n − 1, 3); sample ``i``
@@ -351,11 +361,14 @@ def ekf_kernel(x, is_rate, h, offsets, weights, pi, pj, pc, stride, span, end_of
     C = np.empty((3, 3))
     phi = np.empty(3)
     tmp = np.empty(4)
-    dx = np.zeros(9)
+    nx = P0.shape[0]  # 9, or 12 with the accelerometer bias
+    dx = np.zeros(nx)
+    acc_bias = np.zeros(3)
+    fk = np.empty(3)  # bias-corrected specific force of the current sample
     eps = np.empty(3)
     bias_x = np.empty(3)
-    wk = (np.empty((9, 3)), np.empty((9, 3)), np.empty((9, 3)), np.empty((9, 3)),
-          np.empty((9, 9)), np.empty((3, 3)), np.empty((3, 3)))
+    wk = (np.empty((nx, 3)), np.empty((nx, 3)), np.empty((nx, 3)), np.empty((nx, 3)),
+          np.empty((nx, nx)), np.empty((3, 3)), np.empty((3, 3)))
     # rest detector (exponential moving averages of gyro and accelerometer)
     gm = np.zeros(3)
     g2 = np.zeros(3)
@@ -442,7 +455,7 @@ def ekf_kernel(x, is_rate, h, offsets, weights, pi, pj, pc, stride, span, end_of
         tau_a = params[P_SINGER_TAU]
         qa = params[P_SINGER_SIGMA] ** 2 * (1.0 - np.exp(-2.0 * T / tau_a))
         _propagate(P, phi, T, np.exp(-T / tau_a), params[P_GYRO_NOISE] ** 2 * T,
-                   params[P_BIAS_RW] ** 2 * T, qa)
+                   params[P_BIAS_RW] ** 2 * T, qa, params[P_ACC_BIAS_RW] ** 2 * T)
         # ---------------- measurement updates ----------------
         flags = 0
         dx[:] = 0.0
@@ -462,7 +475,7 @@ def ekf_kernel(x, is_rate, h, offsets, weights, pi, pj, pc, stride, span, end_of
         if use_rest:
             if (acc_quiet and np.sqrt(sg) < params[P_REST_GYRO]
                     and wm < 5.0 * params[P_REST_GYRO]):
-                H = np.zeros((3, 9))
+                H = np.zeros((3, nx))
                 for a in range(3):
                     H[a, 3 + a] = 1.0
                 R = np.eye(3) * params[P_REST_NOISE] ** 2 / T
@@ -470,11 +483,13 @@ def ekf_kernel(x, is_rate, h, offsets, weights, pi, pj, pc, stride, span, end_of
                 _joseph(P, H, R, y, 0.0, False, True, dx, False, wk)
                 flags |= F_REST
         nis_acc = np.nan
+        for a in range(3):
+            fk[a] = acc[k, a] - acc_bias[a]
         if use_acc and lp_tau > 0.0:
             # low-pass model: the specific force in the reference frame, averaged over τ,
             # is gravity (manoeuvres average out); lp − g_up ≈ [g_up×] C δθ (horizontal rows)
             for a in range(3):
-                fn[a] = C[a, 0] * acc[k, 0] + C[a, 1] * acc[k, 1] + C[a, 2] * acc[k, 2]
+                fn[a] = C[a, 0] * fk[0] + C[a, 1] * fk[1] + C[a, 2] * fk[2]
             if not lp_init:
                 lp[:] = fn
                 lp_init = True
@@ -482,10 +497,13 @@ def ekf_kernel(x, is_rate, h, offsets, weights, pi, pj, pc, stride, span, end_of
                 al = min(1.0, T / lp_tau)
                 for a in range(3):
                     lp[a] += al * (fn[a] - lp[a])
-            H = np.zeros((2, 9))
+            H = np.zeros((2, nx))
             for a in range(3):
                 H[0, a] = -g * C[1, a]
                 H[1, a] = g * C[0, a]
+                if nx > 9:  # the residual accelerometer bias, seen in the reference frame
+                    H[0, 9 + a] = C[0, a]
+                    H[1, 9 + a] = C[1, a]
             y = np.empty(2)
             y[0] = lp[0]
             y[1] = lp[1]
@@ -512,7 +530,7 @@ def ekf_kernel(x, is_rate, h, offsets, weights, pi, pj, pc, stride, span, end_of
             v = np.empty(3)
             for a in range(3):
                 v[a] = C[2, a] * g  # C_b_n [0, 0, g]
-            H = np.zeros((3, 9))
+            H = np.zeros((3, nx))
             H[0, 1] = -v[2]
             H[0, 2] = v[1]
             H[1, 0] = v[2]
@@ -521,11 +539,13 @@ def ekf_kernel(x, is_rate, h, offsets, weights, pi, pj, pc, stride, span, end_of
             H[2, 1] = v[0]
             for a in range(3):
                 H[a, 6 + a] = 1.0
-            fa = np.sqrt(acc[k, 0] ** 2 + acc[k, 1] ** 2 + acc[k, 2] ** 2)
+                if nx > 9:
+                    H[a, 9 + a] = 1.0
+            fa = np.sqrt(fk[0] ** 2 + fk[1] ** 2 + fk[2] ** 2)
             acc_disturbed = gating and abs(fa - g) > params[P_ACC_NORM_TOL] * g
             y = np.empty(3)
             for a in range(3):
-                y[a] = acc[k, a] - (v[a] + accel[a])
+                y[a] = fk[a] - (v[a] + accel[a])
             _sub_hdx(y, H, dx)
             # rotation seen at a lever arm (centripetal + tangential) widens the noise
             kk = min(k, x.shape[0] - 1)
@@ -584,7 +604,7 @@ def ekf_kernel(x, is_rate, h, offsets, weights, pi, pj, pc, stride, span, end_of
             if gating and (disturbed or tk - mag_clean_since < params[P_MAG_SETTLE]):
                 flags |= F_MAG_DISTURBED
             else:
-                H = np.zeros((1, 9))
+                H = np.zeros((1, nx))
                 for a in range(3):
                     H[0, a] = -C[2, a]
                 yv = np.arctan2(mn[1], mn[0]) - params[P_REF_HEADING]
@@ -627,10 +647,13 @@ def ekf_kernel(x, is_rate, h, offsets, weights, pi, pj, pc, stride, span, end_of
         for a in range(3):
             bias[a] += dx[3 + a]
             accel[a] += dx[6 + a]
+            if nx > 9:
+                acc_bias[a] += dx[9 + a]
         P = 0.5 * (P + P.T)
         out_q[n_out] = q
         out_b[n_out] = bias
         out_a[n_out] = accel
+        out_ab[n_out] = acc_bias
         out_idx[n_out] = k
         out_flags[n_out] = flags
         out_nis[n_out, 0] = nis_acc

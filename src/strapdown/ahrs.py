@@ -6,7 +6,8 @@ papers.md describes):
 - **state** ``x = [δθ_b, δb_g, a_b]``: attitude error in the body frame
   (``q_true = q̂ ⊗ q(δθ_b)``), gyro-bias error, and the manoeuvre
   (non-gravitational) acceleration in the body frame as a first-order
-  Gauss–Markov (Singer) process ``ȧ = −a/τ + w``;
+  Gauss–Markov (Singer) process ``ȧ = −a/τ + w``; optionally the
+  accelerometer bias ``δb_a`` (12 states, ``estimate_acc_bias``);
 - **propagation** of the attitude by any of the library's algorithms on the
   bias-corrected gyro: ``rate-single``, ``rate-three`` (conventional or
   ``structure=sliding``), ``rk4`` (step 2 td) and ``rotvec:N=…`` (on
@@ -136,6 +137,14 @@ class AhrsConfig:
         Noise density of the zero-rate bias measurement, rad/s/√Hz. Default 1.2e-4.
     rest_tau : float
         Averaging time of the rest detector, s. Default 0.5.
+    estimate_acc_bias : bool
+        Add the accelerometer bias to the state (12 states). Off by default:
+        it is observable only through attitude changes, and a consumer IMU's
+        factory calibration usually leaves less than the filter can resolve.
+    acc_bias_sigma0 : float
+        Its initial uncertainty, m/s². Default 0.1.
+    acc_bias_rw : float
+        Its random walk, m/s²/√s. Default 1e-4.
     gating : bool
         Innovation gating and magnetic-disturbance rejection (default on).
     rest_update : bool
@@ -178,6 +187,9 @@ class AhrsConfig:
     rest_acc: float = 0.2
     rest_noise: float = 1.2e-4
     rest_tau: float = 0.5
+    estimate_acc_bias: bool = False
+    acc_bias_sigma0: float = 0.1
+    acc_bias_rw: float = 1e-4
     gating: bool = True
     rest_update: bool = True
     use_accelerometer: bool = True
@@ -229,6 +241,8 @@ class AhrsResult:
     attitude_sigma : ndarray (m, 3)
         Standard deviation of δθ_b, rad.
     algorithm : str
+    acc_bias : ndarray (m, 3) or None
+        Estimated accelerometer bias, m/s² (with ``estimate_acc_bias``).
     """
 
     t: np.ndarray
@@ -243,6 +257,7 @@ class AhrsResult:
     attitude_sigma: np.ndarray
     algorithm: str
     config: AhrsConfig = field(repr=False, default_factory=AhrsConfig)
+    acc_bias: np.ndarray | None = None
 
     def fraction(self, flag: int) -> float:
         """Share of outputs with a flag set (e.g. ``K.F_MAG_USED``)."""
@@ -364,6 +379,7 @@ def _params(cfg: AhrsConfig, ref, use_mag: bool) -> np.ndarray:
     p[K.P_ACC_LP_TAU] = cfg.acc_lowpass_s if cfg.acc_model == "lowpass" else 0.0
     p[K.P_ACC_LP_NOISE] = cfg.acc_lowpass_noise
     p[K.P_ACC_GATE_LP] = cfg.acc_gate_lowpass
+    p[K.P_ACC_BIAS_RW] = cfg.acc_bias_rw
     return p
 
 
@@ -458,14 +474,18 @@ def ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
     b0 = np.zeros(3) if gyro_bias0 is None else _check("gyro_bias0", [gyro_bias0], 1)[0]
     a = _algorithm(algorithm)
     x = rec.omega if a["is_rate"] else 0.5 * h * (rec.omega[1:] + rec.omega[:-1])
-    P0 = np.zeros((9, 9))
+    nx = 12 if cfg.estimate_acc_bias else 9
+    P0 = np.zeros((nx, nx))
     P0[:3, :3] = np.eye(3) * cfg.attitude_sigma0**2
     P0[3:6, 3:6] = np.eye(3) * cfg.gyro_bias_sigma0**2
-    P0[6:, 6:] = np.eye(3) * cfg.singer_sigma**2
+    P0[6:9, 6:9] = np.eye(3) * cfg.singer_sigma**2
+    if nx == 12:
+        P0[9:, 9:] = np.eye(3) * cfg.acc_bias_sigma0**2
     m = n  # at most one output per sample
     out_q = np.empty((m, 4))
     out_b = np.empty((m, 3))
     out_a = np.empty((m, 3))
+    out_ab = np.empty((m, 3))
     out_idx = np.empty(m, np.int64)
     out_flags = np.empty(m, np.int64)
     out_nis = np.empty((m, 2))
@@ -473,13 +493,14 @@ def ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
     k = K.ekf_kernel(np.ascontiguousarray(x), a["is_rate"], h, a["offsets"], a["weights"],
                      a["pi"], a["pj"], a["pc"], a["stride"], a["span"], a["end_off"], a["lag"],
                      a["start_c"], a["rk4"], acc, mag, _params(cfg, ref, have_mag), q_init, b0,
-                     P0, out_q, out_b, out_a, out_idx, out_flags, out_nis, out_sig)
+                     P0, out_q, out_b, out_a, out_ab, out_idx, out_flags, out_nis, out_sig)
     q = out_q[:k]
     if frame == "NED":
         q = quat_multiply(Q_NED_ENU, q)
     idx = out_idx[:k]
     return AhrsResult(rec.t[idx], idx, q, frame, have_mag, out_b[:k], out_a[:k], out_flags[:k],
-                      out_nis[:k], out_sig[:k], algorithm, cfg)
+                      out_nis[:k], out_sig[:k], algorithm, cfg,
+                      out_ab[:k] if cfg.estimate_acc_bias else None)
 
 
 def gate_threshold(dof: int, probability: float = 0.999) -> float:
