@@ -279,6 +279,14 @@ def _joseph(P, H, R, y, gate, gating, force, dx, soft, wk):
 
 
 @njit(cache=True, inline="always")
+def _outcome(ok, tk, bad_since, used, rejected):
+    """Flag bits and the start of the current run of rejections after one gated update."""
+    if ok:
+        return used, -1.0
+    return rejected, tk if bad_since < 0.0 else bad_since
+
+
+@njit(cache=True, inline="always")
 def _sub_hdx(y, H, dx):
     """y −= H dx."""
     for i in range(y.size):
@@ -519,13 +527,8 @@ def ekf_kernel(x, is_rate, h, offsets, weights, pi, pj, pc, stride, span, end_of
                 flags |= F_ACC_RECOVERED
             nis_acc, ok = _joseph(P, H, R, y, params[P_ACC_GATE_LP], gating, force, dx,
                                   params[P_SOFT_ACC] != 0.0, wk)
-            if ok:
-                flags |= F_ACC_USED
-                acc_bad_since = -1.0
-            else:
-                flags |= F_ACC_REJECTED
-                if acc_bad_since < 0.0:
-                    acc_bad_since = tk
+            bits, acc_bad_since = _outcome(ok, tk, acc_bad_since, F_ACC_USED, F_ACC_REJECTED)
+            flags |= bits
         elif use_acc:
             v = np.empty(3)
             for a in range(3):
@@ -579,13 +582,9 @@ def ekf_kernel(x, is_rate, h, offsets, weights, pi, pj, pc, stride, span, end_of
             else:
                 nis_acc, ok = _joseph(P, H, R, y, params[P_ACC_GATE], gating, force, dx,
                                       params[P_SOFT_ACC] != 0.0, wk)
-                if ok:
-                    flags |= F_ACC_USED
-                    acc_bad_since = -1.0
-                else:
-                    flags |= F_ACC_REJECTED
-                    if acc_bad_since < 0.0:
-                        acc_bad_since = tk
+                bits, acc_bad_since = _outcome(ok, tk, acc_bad_since, F_ACC_USED,
+                                               F_ACC_REJECTED)
+                flags |= bits
         nis_mag = np.nan
         if use_mag:
             mb = mag[k]
@@ -622,13 +621,9 @@ def ekf_kernel(x, is_rate, h, offsets, weights, pi, pj, pc, stride, span, end_of
                     force = True
                     flags |= F_MAG_RECOVERED
                 nis_mag, ok = _joseph(P, H, R, y, params[P_MAG_GATE], gating, force, dx, False, wk)
-                if ok:
-                    flags |= F_MAG_USED
-                    mag_bad_since = -1.0
-                else:
-                    flags |= F_MAG_REJECTED
-                    if mag_bad_since < 0.0:
-                        mag_bad_since = tk
+                bits, mag_bad_since = _outcome(ok, tk, mag_bad_since, F_MAG_USED,
+                                               F_MAG_REJECTED)
+                flags |= bits
         # ---------------- reset ----------------
         for a in range(3):
             eps[a] = C[a, 0] * dx[0] + C[a, 1] * dx[1] + C[a, 2] * dx[2]
