@@ -19,9 +19,7 @@ usage). The input is never overwritten.
 
 from __future__ import annotations
 
-import csv
 import json
-import warnings
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
@@ -30,7 +28,7 @@ import numpy as np
 from strapdown import _ahrs_kernel as K
 from strapdown._io import write_text
 from strapdown.ahrs import AhrsConfig, AhrsResult, ekf
-from strapdown.io import RATE_PLAUSIBLE_MAX, UnitWarning, write_attitude
+from strapdown.io import check_rows, csv_columns, warn_implausible_rate, write_attitude
 
 __all__ = ["AhrsLog", "read_ahrs_log", "run_ahrs"]
 
@@ -48,30 +46,12 @@ class AhrsLog:
 
 
 def _csv(path: Path, columns):
-    with open(path, newline="", encoding="utf-8") as f:
-        try:
-            header = [c.strip() for c in next(csv.reader(f))]
-        except StopIteration:
-            raise ValueError(f"{path}: empty file") from None
-    need = list(columns[:7])
-    missing = [c for c in need if c not in header]
-    if missing:
-        raise ValueError(f"{path}: columns {missing} not in the header {header}; map them "
-                         "with --columns")
-    mag_cols = list(columns[7:10])
-    have_mag = len(mag_cols) == 3 and all(c in header for c in mag_cols)
-    try:
-        raw = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
-    except ValueError as exc:
-        raise ValueError(f"{path}: unreadable number ({exc})") from None
-    if raw.shape[1] != len(header):
-        raise ValueError(f"{path}: rows have {raw.shape[1]} fields, the header {len(header)}")
-    col = {c: raw[:, header.index(c)] for c in header}
-    t = col[columns[0]]
-    g = np.column_stack([col[c] for c in columns[1:4]])
-    a = np.column_stack([col[c] for c in columns[4:7]])
-    m = np.column_stack([col[c] for c in mag_cols]) if have_mag else None
-    return t, g, a, m
+    raw, units, have_mag = csv_columns(path, columns[:7], optional=columns[7:10])
+    if units:
+        raise ValueError(f"{path}: units in the header ({units}) are not read for AHRS logs; "
+                         "name the columns plainly and declare --gyro-units/--acc-units")
+    m = raw[:, 7:10] if have_mag else None
+    return raw[:, 0], raw[:, 1:4], raw[:, 4:7], m
 
 
 def read_ahrs_log(path, *, gyro_units: str = "rad/s", acc_units: str = "m/s2",
@@ -96,26 +76,13 @@ def read_ahrs_log(path, *, gyro_units: str = "rad/s", acc_units: str = "m/s2",
         t, g, a, m = _csv(path, list(columns))
     else:
         raise ValueError(f"{path}: unsupported format (use a BROAD .mat or a CSV)")
-    for name, arr in (("time", t[:, None]), ("gyro", g), ("accelerometer", a),
-                      *((("magnetometer", m),) if m is not None else ())):
-        bad = ~np.all(np.isfinite(arr), axis=1)
-        if np.any(bad):
-            raise ValueError(f"{path}: NaN or infinity in the {name} at data row "
-                             f"{int(np.argmax(bad)) + 1}")
-    from strapdown._validation import first_bad_step
-
-    fault = first_bad_step(np.diff(t))
-    if fault is not None:
-        i, what = fault
-        raise ValueError(f"{path}: {what} time stamp in data row {i + 2}")
+    check_rows(path, t, [("time", [t]), ("gyro", [g]), ("accelerometer", [a]),
+                         *((("magnetometer", [m]),) if m is not None else ())])
     if gyro_units == "deg/s":
         g = np.radians(g)
     if acc_units == "g":
         a = a * 9.80665
-    big = float(np.percentile(np.linalg.norm(g, axis=1), 99))
-    if gyro_units == "rad/s" and big > RATE_PLAUSIBLE_MAX:
-        warnings.warn(f"{path}: 99th-percentile gyro rate {big:.0f} rad/s is implausible; the "
-                      "log is more likely in deg/s", UnitWarning, stacklevel=2)
+    warn_implausible_rate(path, g, gyro_units, suggestion="deg/s")
     if m is not None and not np.any(m):
         m = None
     return AhrsLog(t, np.ascontiguousarray(g), np.ascontiguousarray(a),

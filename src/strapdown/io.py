@@ -35,7 +35,16 @@ import numpy as np
 from strapdown._io import atomic_path
 from strapdown._validation import first_bad_step
 
-__all__ = ["RATE_PLAUSIBLE_MAX", "ImuLog", "UnitWarning", "read_imu", "write_attitude"]
+__all__ = [
+    "RATE_PLAUSIBLE_MAX",
+    "ImuLog",
+    "UnitWarning",
+    "check_rows",
+    "csv_columns",
+    "read_imu",
+    "warn_implausible_rate",
+    "write_attitude",
+]
 
 #: Largest body rate (rad/s) considered plausible when a log says rad/s (~2000 °/s × 1.75;
 #: spinning shells reach 20 r/s ≈ 126 rad/s, so only beyond 200 rad/s do we suspect deg/s).
@@ -98,7 +107,16 @@ def _split_header(cells):
     return names, units
 
 
-def _load_csv(path: Path, columns):
+def csv_columns(path, columns, optional=()) -> tuple[np.ndarray, dict, bool]:
+    """Named columns of a CSV log with a header row.
+
+    Returns ``(values, units, have_optional)``: ``values`` holds ``columns``
+    followed by ``optional`` when every optional column is present, ``units``
+    the header's bracketed units by column name (``gx[deg/s]``). Errors name
+    missing columns, a file without data rows, unreadable numbers and rows
+    whose field count differs from the header's.
+    """
+    path = Path(path)
     with open(path, newline="", encoding="utf-8") as f:
         reader = csv.reader(f)
         try:
@@ -109,7 +127,9 @@ def _load_csv(path: Path, columns):
         if missing:
             raise ValueError(f"{path}: columns {missing} not in the header {header}; map them "
                              "with --columns")
-        idx = [header.index(c) for c in columns]
+        have_optional = bool(optional) and all(c in header for c in optional)
+        wanted = list(columns) + (list(optional) if have_optional else [])
+        idx = [header.index(c) for c in wanted]
         text = f.read()
     if not text.strip():
         raise ValueError(f"{path}: no data rows")
@@ -119,10 +139,47 @@ def _load_csv(path: Path, columns):
         raise ValueError(f"{path}: unreadable number ({exc})") from exc
     if raw.shape[1] != len(header):
         raise ValueError(f"{path}: rows have {raw.shape[1]} fields, the header {len(header)}")
+    return raw[:, idx], units, have_optional
+
+
+def _load_csv(path: Path, columns):
+    raw, units, _ = csv_columns(path, columns)
     axis_units = {units[c] for c in columns[1:] if c in units}
     if len(axis_units) > 1:
         raise ValueError(f"{path}: the header gives the axes different units {sorted(axis_units)}")
-    return raw[:, idx], (axis_units.pop() if axis_units else None)
+    return raw, (axis_units.pop() if axis_units else None)
+
+
+def check_rows(path, t, groups) -> None:
+    """Raise on the first non-finite row of each group and on a bad time step.
+
+    ``groups``: ``(label, arrays)`` pairs checked in order; a row is bad when
+    any array of the group is not finite there. Rows count from 1 (the first
+    data row); ``label`` None gives "NaN or infinity in data row r".
+    """
+    for label, arrays in groups:
+        bad = np.zeros(t.shape[0], bool)
+        for a in arrays:
+            a = np.asarray(a)
+            bad |= ~np.isfinite(a) if a.ndim == 1 else ~np.all(np.isfinite(a), axis=1)
+        if np.any(bad):
+            where = "" if label is None else f" the {label} at"
+            raise ValueError(f"{path}: NaN or infinity in{where} data row "
+                             f"{int(np.argmax(bad)) + 1}")
+    fault = first_bad_step(np.diff(t))
+    if fault is not None:
+        i, what = fault
+        raise ValueError(f"{path}: {what} time stamp in data row {i + 2} (t = {t[i + 1]!r} "
+                         f"after {t[i]!r})")
+
+
+def warn_implausible_rate(path, rate, declared: str, suggestion: str = "degrees") -> None:
+    """Warn when rates (rad/s) declared in radians have magnitudes that suggest degrees."""
+    big = float(np.percentile(np.linalg.norm(rate, axis=1), 99))
+    if not declared.startswith("deg") and big > RATE_PLAUSIBLE_MAX:
+        warnings.warn(f"{path}: 99th-percentile rate {big:.0f} rad/s is implausible; the log is "
+                      f"more likely in {suggestion} (declared {declared})", UnitWarning,
+                      stacklevel=3)
 
 
 def _load_hdf5(path: Path, sample_rate_hz):
@@ -245,16 +302,8 @@ def read_imu(path, *, kind: str, units: str | None, columns=("t", "gx", "gy", "g
                          f"{g.shape}")
     if t.size < 2:
         raise ValueError(f"{path}: {t.size} samples; at least 2 are needed")
-    bad = ~np.isfinite(t) | ~np.all(np.isfinite(g), axis=1)
-    if np.any(bad):
-        row = int(np.argmax(bad)) + 1
-        raise ValueError(f"{path}: NaN or infinity in data row {row}")
+    check_rows(path, t, [(None, [t, g])])
     d = np.diff(t)
-    fault = first_bad_step(d)
-    if fault is not None:
-        i, what = fault
-        raise ValueError(f"{path}: {what} time stamp in data row {i + 2} (t = {t[i + 1]!r} "
-                         f"after {t[i]!r})")
     h = float(np.median(d))
     gaps = [int(i) + 2 for i in np.flatnonzero(d > gap_tolerance * h)]
     if gaps and on_gap == "error":
@@ -267,10 +316,8 @@ def read_imu(path, *, kind: str, units: str | None, columns=("t", "gx", "gy", "g
     scale = _DEG if units.startswith("deg") else 1.0
     g = g * scale
     rate = g if kind == "rate" else g / h
+    warn_implausible_rate(path, rate, units)
     big = float(np.percentile(np.linalg.norm(rate, axis=1), 99))
-    if not units.startswith("deg") and big > RATE_PLAUSIBLE_MAX:
-        warnings.warn(f"{path}: 99th-percentile rate {big:.0f} rad/s is implausible; the log is "
-                      f"more likely in degrees (declared {units})", UnitWarning, stacklevel=2)
     if units.startswith("deg") and big < 1e-3 * _DEG and big > 0:
         warnings.warn(f"{path}: 99th-percentile rate {big / _DEG:.2e} °/s is implausibly small; "
                       f"the log is more likely in radians (declared {units})", UnitWarning,
