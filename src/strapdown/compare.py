@@ -159,10 +159,8 @@ def _run_on_log(log, fields, q0):
         sol = rate.rate_attitude(log.t, log.data, algorithm=alg, structure=structure,
                                  coefficients=fields.get("coefficients") or "derived",
                                  rk4_step=fields.get("rk4_step", "2td"), q0=q0)
-        period = {"rate-single": log.h, "rk4": 2 * log.h if fields.get(
-            "rk4_step", "2td") == "2td" else log.h,
-            "rate-three": log.h if structure == "sliding" else 3 * log.h}[alg]
-        return sol, period
+        return sol, rate.update_period(alg, log.h, structure=structure,
+                                       rk4_step=fields.get("rk4_step", "2td"))
     if alg != "rotvec":
         raise ValueError(f"{alg} runs on reference motions only (its input is the Krylov model's "
                          "increments at thirds or halves of a step); use rotvec or a rate "

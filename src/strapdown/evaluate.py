@@ -307,8 +307,7 @@ def _evaluate_rate(cfg: EvaluationConfig, motion: Motion) -> Evaluation:
         if order is not None:
             predicted = (-float(c) * motion.half_angle**2 * motion.cone_rate
                          * (motion.cone_rate * h) ** order)
-    period = {"rate-single": h, "rate-three": h if sliding else 3 * h,
-              "rk4": 2 * h if cfg.rk4_step == "2td" else h}[alg]
+    period = rate.update_period(alg, h, structure=cfg.structure, rk4_step=cfg.rk4_step)
     return _finish(cfg, motion, t, err, ang, chain, 0, predicted, period, n)
 
 

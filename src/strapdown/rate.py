@@ -50,6 +50,7 @@ __all__ = [
     "rate_attitude",
     "single_period_algorithm",
     "three_period_algorithm",
+    "update_period",
 ]
 
 F = Fraction
@@ -145,6 +146,19 @@ def three_period_algorithm(coefficients: str = "derived") -> WindowedAlgorithm:
     alg = d.algorithm()
     return WindowedAlgorithm(alg.input, alg.update, alg.offsets, alg.weights, alg.pairs,
                              alg.pair_coefficients, f"rate-three ({coefficients})")
+
+
+def update_period(algorithm: str, td: float, *, structure: str = "conventional",
+                  rk4_step: str = "2td") -> float:
+    """Time between attitude outputs of a rate algorithm sampled every ``td``."""
+    if algorithm == "rate-single":
+        return td
+    if algorithm == "rate-three":
+        return td if structure == "sliding" else 3 * td
+    if algorithm == "rk4":
+        _check_step(rk4_step)
+        return 2 * td if rk4_step == "2td" else td
+    raise ValueError(f"unknown rate algorithm {algorithm!r}; choose one of {', '.join(ALGORITHMS)}")
 
 
 def predicted_drift_law(algorithm: str, *, coefficients: str = "derived",
