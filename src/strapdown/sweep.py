@@ -55,7 +55,7 @@ from pathlib import Path
 
 import numpy as np
 
-from strapdown._io import atomic_path, write_text
+from strapdown._io import atomic_path, csv_table, write_text
 from strapdown.compare import parse_spec
 from strapdown.evaluate import EvaluationConfig, evaluate
 from strapdown.sensors import GyroErrors
@@ -384,19 +384,16 @@ def _columns(rows) -> list[str]:
     return cols
 
 
-def _cell(v) -> str:
+def _text(v) -> str:
+    """A table value as CSV text: floats round-trip (repr), missing values are empty."""
     if v is None or (isinstance(v, float) and math.isnan(v)):
         return ""
-    if isinstance(v, float):
-        return repr(v)
-    s = str(v)
-    return f'"{s}"' if ("," in s or '"' in s) else s
+    return repr(v) if isinstance(v, float) else str(v)
 
 
 def _write_csv(path: Path, rows) -> Path:
     cols = _columns(rows)
-    lines = [",".join(cols)] + [",".join(_cell(r.get(c)) for c in cols) for r in rows]
-    return write_text(path, "\n".join(lines) + "\n")
+    return write_text(path, csv_table(cols, [[_text(r.get(c)) for c in cols] for r in rows]))
 
 
 def _write_parquet(path: Path, rows) -> Path:
