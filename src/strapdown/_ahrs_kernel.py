@@ -112,10 +112,10 @@ def _left_rotate(eps, q):
 
 
 @njit(cache=True)
-def _window_phi(x, b, offsets, weights, pi, pj, pc, sa, sb, bias_x, phi):
-    """φ of the windowed form over samples starting at b, bias removed from every node."""
+def _window_phi(x, b, offsets, weights, pi, pj, pc, sa, sb, bias_x, phi, nodes):
+    """φ of the windowed form over samples starting at b, bias removed from every node
+    (``nodes``: a work array with a row per node)."""
     m = offsets.size
-    nodes = np.empty((m, 3))
     for n in range(m):
         for a in range(3):
             nodes[n, a] = x[b + offsets[n], a] - bias_x[a]
@@ -279,6 +279,12 @@ def _joseph(P, H, R, y, gate, gating, force, dx, soft, wk):
 
 
 @njit(cache=True, inline="always")
+def _recovery_due(gating, clean, bad_since, tk, limit):
+    """Innovations have failed the gate for longer than ``limit`` while the sensor looks clean."""
+    return gating and clean and bad_since >= 0.0 and tk - bad_since > limit
+
+
+@njit(cache=True, inline="always")
 def _outcome(ok, tk, bad_since, used, rejected):
     """Flag bits and the start of the current run of rejections after one gated update."""
     if ok:
@@ -375,6 +381,7 @@ def ekf_kernel(x, is_rate, h, offsets, weights, pi, pj, pc, stride, span, end_of
     fk = np.empty(3)  # bias-corrected specific force of the current sample
     eps = np.empty(3)
     bias_x = np.empty(3)
+    nodes = np.empty((max(offsets.size, 1), 3))
     wk = (np.empty((nx, 3)), np.empty((nx, 3)), np.empty((nx, 3)), np.empty((nx, 3)),
           np.empty((nx, nx)), np.empty((3, 3)), np.empty((3, 3)))
     # rest detector (exponential moving averages of gyro and accelerometer)
@@ -439,7 +446,7 @@ def ekf_kernel(x, is_rate, h, offsets, weights, pi, pj, pc, stride, span, end_of
             e = step - n_start
             b = e * stride
             k = b + end_off
-            _window_phi(x, b, offsets, weights, pi, pj, pc, sa, sb, bias_x, phi)
+            _window_phi(x, b, offsets, weights, pi, pj, pc, sa, sb, bias_x, phi, nodes)
             base = ring[e % lag] if lag > 1 else q
             _update(base, phi, tmp)
             q[:] = tmp
@@ -493,6 +500,16 @@ def ekf_kernel(x, is_rate, h, offsets, weights, pi, pj, pc, stride, span, end_of
         nis_acc = np.nan
         for a in range(3):
             fk[a] = acc[k, a] - acc_bias[a]
+        # recovery: inflate the tilt (and, in the raw model, the manoeuvre acceleration)
+        force = use_acc and _recovery_due(gating, acc_quiet, acc_bad_since, tk,
+                                          params[P_RECOVER_ACC])
+        if force:
+            ra = params[P_RECOVER_ANGLE] ** 2
+            for a in range(3):
+                P[a, a] += ra
+                if lp_tau <= 0.0:
+                    P[6 + a, 6 + a] += params[P_SINGER_SIGMA] ** 2
+            flags |= F_ACC_RECOVERED
         if use_acc and lp_tau > 0.0:
             # low-pass model: the specific force in the reference frame, averaged over τ,
             # is gravity (manoeuvres average out); lp − g_up ≈ [g_up×] C δθ (horizontal rows)
@@ -517,14 +534,6 @@ def ekf_kernel(x, is_rate, h, offsets, weights, pi, pj, pc, stride, span, end_of
             y[1] = lp[1]
             _sub_hdx(y, H, dx)
             R = np.eye(2) * params[P_ACC_LP_NOISE] ** 2 / T
-            force = False
-            if (gating and acc_quiet and acc_bad_since >= 0.0
-                    and tk - acc_bad_since > params[P_RECOVER_ACC]):
-                ra = params[P_RECOVER_ANGLE] ** 2
-                for a in range(3):
-                    P[a, a] += ra
-                force = True
-                flags |= F_ACC_RECOVERED
             nis_acc, ok = _joseph(P, H, R, y, params[P_ACC_GATE_LP], gating, force, dx,
                                   params[P_SOFT_ACC] != 0.0, wk)
             bits, acc_bad_since = _outcome(ok, tk, acc_bad_since, F_ACC_USED, F_ACC_REJECTED)
@@ -568,15 +577,6 @@ def ekf_kernel(x, is_rate, h, offsets, weights, pi, pj, pc, stride, span, end_of
                     wd2 += ((x[kk, a] - x[kk - 1, a]) / (h * h)) ** 2
             lever = params[P_LEVER] * (w2 + np.sqrt(wd2))
             R = np.eye(3) * (params[P_ACC_NOISE] ** 2 / T + lever * lever)
-            force = False
-            if (gating and acc_quiet and acc_bad_since >= 0.0
-                    and tk - acc_bad_since > params[P_RECOVER_ACC]):
-                ra = params[P_RECOVER_ANGLE] ** 2
-                for a in range(3):
-                    P[a, a] += ra
-                    P[6 + a, 6 + a] += params[P_SINGER_SIGMA] ** 2
-                force = True
-                flags |= F_ACC_RECOVERED
             if acc_disturbed:
                 flags |= F_ACC_DISTURBED
             else:
@@ -611,9 +611,8 @@ def ekf_kernel(x, is_rate, h, offsets, weights, pi, pj, pc, stride, span, end_of
                 y = np.array([yv])
                 _sub_hdx(y, H, dx)
                 R = np.eye(1) * params[P_HEADING_NOISE] ** 2 / T
-                force = False
-                if (gating and mag_bad_since >= 0.0
-                        and tk - mag_bad_since > params[P_RECOVER_MAG]):
+                force = _recovery_due(gating, True, mag_bad_since, tk, params[P_RECOVER_MAG])
+                if force:
                     ra = params[P_RECOVER_ANGLE] ** 2
                     for r in range(3):
                         for s in range(3):
