@@ -50,19 +50,14 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from strapdown import _ahrs_kernel as K
-from strapdown._validation import as_quaternions, positive
+from strapdown._validation import as_quaternions
 from strapdown.rotation.quaternion import quat_multiply
 
-__all__ = ["AhrsConfig", "AhrsResult", "attitude_from_acc_mag", "ekf", "propagation_algorithms"]
+__all__ = ["AhrsConfig", "AhrsResult", "attitude_from_acc_mag", "ekf"]
 
 G = 9.80665
 #: q_NED_ENU: rotation by π about (1, 1, 0)/√2 (swaps x and y, flips z).
 Q_NED_ENU = np.array([0.0, math.sqrt(0.5), math.sqrt(0.5), 0.0])
-
-
-def propagation_algorithms() -> tuple[str, ...]:
-    """Names accepted as ``algorithm`` (options as in :func:`strapdown.compare.parse_spec`)."""
-    return ("rate-single", "rate-three", "rate-three:structure=sliding", "rk4", "rotvec:N=…")
 
 
 @dataclass(frozen=True)
@@ -118,8 +113,8 @@ class AhrsConfig:
     mag_dip_tol : float
         … or whose dip angle departs by more than this, rad. Default 0.1 (5.7°).
     acc_norm_tol : float
-        Skip the accelerometer when its norm departs from g by more than this
-        fraction (sustained manoeuvres, impacts). Default 0.25.
+        Raw model only: skip the accelerometer when its norm departs from g by
+        more than this fraction (sustained manoeuvres, impacts). Default 0.25.
     mag_settle_s : float
         After a magnetic disturbance, the field must stay plausible this long
         before it is used again, s. Default 1.
@@ -310,12 +305,11 @@ def _algorithm(spec: str):
     f0 = np.zeros(0)
     from strapdown import rate
 
-    start_c = float(rate._single_coefficient(coeffs or "derived")) if alg != "rotvec" else 0.0
     if alg == "rk4":
         if f.get("rk4_step", "2td") != "2td" or structure != "conventional" or coeffs:
             raise ValueError("the filter's rk4 is the 2td step, conventional structure")
         return dict(is_rate=True, offsets=i0, weights=f0, pi=i0, pj=i0, pc=f0, stride=2,
-                    span=2, end_off=2, lag=1, start_c=start_c, rk4=True)
+                    span=2, end_off=2, lag=1, start_c=0.0, rk4=True)
     if alg in ("rate-single", "rate-three"):
         if alg == "rate-single":
             w = rate.single_period_algorithm(coeffs or "derived")
@@ -325,6 +319,9 @@ def _algorithm(spec: str):
             raise ValueError(f"{alg} supports {', '.join(rate.STRUCTURES[alg])}, not {structure}")
         sliding = structure == "sliding"
         lag = w.span if sliding else 1
+        # the sliding scheme starts with single-period steps of the same coefficient set
+        start_c = (float(rate.single_period_algorithm(coeffs or "derived").pair_coefficients[0])
+                   if sliding else 0.0)
         return dict(is_rate=True, offsets=np.array(w.offsets, np.int64),
                     weights=np.array([float(x) for x in w.weights]),
                     pi=np.array([p[0] for p in w.pairs], np.int64),
@@ -502,10 +499,3 @@ def ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
                       out_nis[:k], out_sig[:k], algorithm, cfg,
                       out_ab[:k] if cfg.estimate_acc_bias else None)
 
-
-def gate_threshold(dof: int, probability: float = 0.999) -> float:
-    """χ² quantile for an innovation gate (``acc_gate`` = 3 dof, ``mag_gate`` = 1 dof)."""
-    from scipy.stats import chi2
-
-    positive(probability, "probability")
-    return float(chi2.ppf(probability, dof))

@@ -96,9 +96,10 @@ def broad_errors(q_est, q_ref, movement, *, heading_offset: bool = True) -> dict
         dq = quat_multiply(rot, dq)
     w = np.clip(np.abs(dq[:, 0]), 0.0, 1.0)
     total = 2.0 * np.arctan2(np.linalg.norm(dq[:, 1:], axis=1), w)
-    heading = np.abs((_twist_z(dq) + np.pi) % (2 * np.pi) - np.pi)
+    twist = _twist_z(dq)
+    heading = np.abs((twist + np.pi) % (2 * np.pi) - np.pi)
     # swing = δq ⊗ twist*: its angle is the inclination error
-    half = 0.5 * _twist_z(dq)
+    half = 0.5 * twist
     twist_conj = np.column_stack([np.cos(half), np.zeros_like(half), np.zeros_like(half),
                                   -np.sin(half)])
     swing = quat_multiply(dq, twist_conj)
