@@ -167,6 +167,17 @@ def _cmd_export(args) -> int:
     return 0
 
 
+def _progress_args(p) -> None:
+    prog = p.add_mutually_exclusive_group()
+    prog.add_argument("--progress", dest="progress", action="store_true", default=None,
+                      help="progress bar on stderr (default: when stderr is a terminal)")
+    prog.add_argument("--no-progress", dest="progress", action="store_false")
+
+
+def _progress(args) -> bool:
+    return sys.stderr.isatty() if args.progress is None else args.progress
+
+
 def _add_run(sub) -> None:
     p = sub.add_parser("run", help="attitude from a gyro log (CSV, .npy, .npz, .mat)",
                        description="Validate a gyro log, run an algorithm over it (streamed "
@@ -196,10 +207,7 @@ def _add_run(sub) -> None:
                    help="gap threshold in median sample intervals (default 1.5)")
     p.add_argument("--saturation", type=float, default=None,
                    help="sensor range in the declared unit; saturated rows are reported")
-    prog = p.add_mutually_exclusive_group()
-    prog.add_argument("--progress", dest="progress", action="store_true", default=None,
-                      help="progress bar on stderr (default: when stderr is a terminal)")
-    prog.add_argument("--no-progress", dest="progress", action="store_false")
+    _progress_args(p)
     p.add_argument("--out", required=True, help="output .csv or .npz")
 
 
@@ -212,7 +220,7 @@ def _cmd_run(args) -> int:
                   subsamples=args.subsamples, coefficients=args.coefficients, columns=cols,
                   sample_rate_hz=args.sample_rate_hz, angles=args.angles, on_gap=args.on_gap,
                   gap_tolerance=args.gap_tolerance, saturation=args.saturation,
-                  progress=sys.stderr.isatty() if args.progress is None else args.progress)
+                  progress=_progress(args))
     for w in res["warnings"]:
         print(f"warning: {w}", file=sys.stderr)
     if res["gaps"]:
@@ -291,9 +299,7 @@ def _add_sweep(sub) -> None:
                    help="table formats, comma-separated: csv, parquet (default both)")
     p.add_argument("--max-cases", type=int, default=None,
                    help="compute at most this many new cases, then stop")
-    prog = p.add_mutually_exclusive_group()
-    prog.add_argument("--progress", dest="progress", action="store_true", default=None)
-    prog.add_argument("--no-progress", dest="progress", action="store_false")
+    _progress_args(p)
 
 
 def _cmd_sweep(args) -> int:
@@ -302,7 +308,7 @@ def _cmd_sweep(args) -> int:
     res = sweep(args.scenario, args.out, scheduler=args.scheduler, workers=args.workers,
                 formats=[f.strip() for f in args.format.split(",") if f.strip()],
                 max_cases=args.max_cases,
-                progress=sys.stderr.isatty() if args.progress is None else args.progress,
+                progress=_progress(args),
                 log=lambda msg: print(msg, file=sys.stderr))
     if not res.complete:
         print(f"{res.skipped + res.computed} of {res.total} cases done; rerun to finish")
