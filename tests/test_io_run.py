@@ -219,3 +219,20 @@ def test_run_progress_bar_goes_to_stderr(tmp_path, capsys):
           "--progress", "--out", str(tmp_path / "a.csv")])
     cap = capsys.readouterr()
     assert "300/300" in cap.err and "wrote" in cap.out
+
+
+def test_streamed_npy_reports_gaps_and_saturation(tmp_path, monkeypatch):
+    import strapdown.run as run_mod
+
+    monkeypatch.setattr(run_mod, "CHUNK", 64)  # the gap and a saturated row in later chunks
+    t = np.r_[np.arange(1, 101), np.arange(111, 201)] * 1e-3
+    th = np.full((t.size, 3), 1e-5)
+    th[150, 0] = 0.01
+    np.save(tmp_path / "log.npy", np.column_stack([t, th]))
+    res = run_log(tmp_path / "log.npy", tmp_path / "a.csv", kind="increment", units="rad",
+                  saturation=0.01)
+    assert res["gaps"] == [101] and res["saturated"] == [151]
+    with pytest.raises(ValueError, match=r"gap of 0\.011 s .* before data row 101"):
+        run_log(tmp_path / "log.npy", tmp_path / "b.csv", kind="increment", units="rad",
+                on_gap="error")
+    assert not (tmp_path / "b.csv").exists()

@@ -52,24 +52,43 @@ def _header(angles):
     return ",".join(names)
 
 
-def _npy_chunks(path: Path, units: str):
-    """Validated (t, increments) chunks of an (n, 4) .npy log, memory-mapped."""
+def _npy_chunks(path: Path, units: str, read: dict, gaps: list, saturated: list):
+    """Validated (t, increments) chunks of an (n, 4) .npy log, memory-mapped.
+
+    Gaps (intervals over ``gap_tolerance`` times the first interval — a
+    streamed log has no median) and saturated rows are appended to ``gaps``
+    and ``saturated`` as the chunks go by; ``on_gap="error"`` raises at the first gap.
+    """
     arr = np.load(path, mmap_mode="r")
     if arr.ndim != 2 or arr.shape[1] != 4:
         raise ValueError(f"{path}: .npy logs must be (n, 4) [t, gx, gy, gz], got {arr.shape}")
     scale = np.pi / 180.0 if units == "deg" else 1.0
     last = None
+    h = None
     for s in range(0, arr.shape[0], CHUNK):
         c = np.array(arr[s:s + CHUNK], dtype=np.float64)
         bad = ~np.all(np.isfinite(c), axis=1)
         if np.any(bad):
             raise ValueError(f"{path}: NaN or infinity in data row {s + int(np.argmax(bad)) + 1}")
         t = c[:, 0] if last is None else np.concatenate([[last], c[:, 0]])
-        fault = first_bad_step(np.diff(t))
+        d = np.diff(t)
+        first = 1 if last is None else 0  # data row (1-based) of t[0] is s + first
+        fault = first_bad_step(d)
         if fault is not None:
             i, what = fault
-            row = s + i + (1 if last is None else 0) + 1
-            raise ValueError(f"{path}: {what} time stamp in data row {row}")
+            raise ValueError(f"{path}: {what} time stamp in data row {s + i + first + 1}")
+        if h is None and d.size:
+            h = float(d[0])
+        if h is not None:
+            for i in np.flatnonzero(d > read["gap_tolerance"] * h):
+                row = s + int(i) + first + 1
+                if read["on_gap"] == "error":
+                    raise ValueError(f"{path}: gap of {d[i]:.6g} s ({d[i] / h:.1f} sample "
+                                     f"intervals) before data row {row}")
+                gaps.append(row)
+        if read["saturation"] is not None:
+            hit = np.flatnonzero(np.any(np.abs(c[:, 1:]) >= read["saturation"], axis=1))
+            saturated.extend(int(s + i + 1) for i in hit)
         last = c[-1, 0]
         yield c[:, 0], c[:, 1:] * scale
 
@@ -126,9 +145,9 @@ def _run_increments(imu, out, read, structure, cs, angles, q0, split, progress):
         if read["units"] is None:
             raise ValueError(f"{imu}: .npy logs carry no units; pass --units")
         total = np.load(imu, mmap_mode="r").shape[0]
-        segments = [_npy_chunks(imu, read["units"])]
         gaps: list = []
         saturated: list = []
+        segments = [_npy_chunks(imu, read["units"], read, gaps, saturated)]
         h_log = 1.0
     else:
         log = read_imu(imu, **read)
