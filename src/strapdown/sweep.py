@@ -62,6 +62,10 @@ from strapdown.sensors import GyroErrors
 
 __all__ = ["Case", "Scenario", "SweepResult", "cases", "load_scenario", "run_case", "sweep"]
 
+#: Metric names a scenario may ask for (keys of Evaluation.to_dict).
+METRICS = ("max_error_rad", "rms_error_rad", "cone_axis_drift_rad_s", "predicted_drift_rad_s",
+           "drift_rate_rad_s", "accumulated_drift_rad", "update_period_s", "samples",
+           "chain_cone_axis_drift_rad_s", "drift_points")
 DEFAULT_METRICS = ("max_error_rad", "rms_error_rad", "cone_axis_drift_rad_s",
                    "predicted_drift_rad_s")
 _CONFIG_FIELDS = {f.name for f in dataclasses.fields(EvaluationConfig)} - {"gyro", "seed"}
@@ -163,20 +167,13 @@ def load_scenario(path) -> Scenario:
         raise ValueError(f"{path}: seed must be a non-negative integer, got {seed!r}")
     scn = Scenario(base, gyro, tuple(algorithms), tuple(metrics), grid, seed)
     all_cases = cases(scn)  # validates every configuration before anything runs
-    known = set(evaluate_keys())
-    bad = [m for m in scn.metrics if m not in known]
+    bad = [m for m in scn.metrics if m not in METRICS]
     if bad:
-        raise ValueError(f"{path}: unknown metric(s) {bad}; choose from {', '.join(sorted(known))}")
+        raise ValueError(f"{path}: unknown metric(s) {bad}; choose from "
+                         f"{', '.join(sorted(METRICS))}")
     if not all_cases:
         raise ValueError(f"{path}: the grid is empty")
     return scn
-
-
-def evaluate_keys() -> tuple[str, ...]:
-    """Metric names a scenario may ask for."""
-    return ("max_error_rad", "rms_error_rad", "cone_axis_drift_rad_s", "predicted_drift_rad_s",
-            "drift_rate_rad_s", "accumulated_drift_rad", "update_period_s", "samples",
-            "chain_cone_axis_drift_rad_s", "drift_points")
 
 
 def cases(scn: Scenario) -> list[Case]:
