@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import json
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 import strapdown._ahrs_kernel as K
+from conftest import BROAD
 from strapdown.ahrs import Q_NED_ENU, AhrsConfig, attitude_from_acc_mag, ekf
 from strapdown.broad import broad_errors
 from strapdown.motions import SpinConing
@@ -17,7 +17,6 @@ from strapdown.rotation.dcm import dcm_from_quat
 from strapdown.rotation.error import attitude_error_angle
 from strapdown.rotation.quaternion import quat_multiply
 
-BROAD = Path(__file__).resolve().parents[2] / "shared" / "data" / "broad"
 ALGS = ["rate-single", "rate-three", "rate-three:structure=sliding", "rk4", "rotvec:N=3"]
 G_UP = np.array([0.0, 0.0, 9.80665])
 M_N = np.array([0.0, 20.0, -40.0])
@@ -185,7 +184,7 @@ def test_broad_metric_on_known_errors():
     assert e["heading_deg"] == pytest.approx(0.0, abs=1e-9)
 
 
-@pytest.mark.skipif(not BROAD.is_dir(), reason="shared/data/broad is not beside the checkout")
+@pytest.mark.skipif(BROAD is None, reason="BROAD data not found (set STRAPDOWN_BROAD)")
 def test_broad_acceptance_against_fusion_and_vqf(tmp_path):
     """Mean total RMSE no worse than Fusion's; gating helps on the magnet trial."""
     pytest.importorskip("imufusion")

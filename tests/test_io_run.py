@@ -3,20 +3,18 @@
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
 from scipy.io import savemat
 
+from conftest import BROAD
 from strapdown.cli import main
 from strapdown.coning import coefficient_set
 from strapdown.io import UnitWarning, read_imu
 from strapdown.motions import PureSpin, SpinConing
 from strapdown.run import run_log
 from strapdown.structures import conventional, realtime
-
-BROAD = Path(__file__).resolve().parents[2] / "shared" / "data" / "broad"
 
 
 def _csv(path, t, g, names=("t", "gx", "gy", "gz")):
@@ -116,7 +114,7 @@ def test_psins_mat_layout(tmp_path):
     assert np.allclose(log.data, wm) and log.h == pytest.approx(0.01)
 
 
-@pytest.mark.skipif(not BROAD.is_dir(), reason="shared/data/broad is not beside the checkout")
+@pytest.mark.skipif(BROAD is None, reason="BROAD data not found (set STRAPDOWN_BROAD)")
 def test_broad_recording_reads_and_runs(tmp_path):
     path = BROAD / "07_undisturbed_fast_rotation_B.mat"
     log = read_imu(path, kind="rate", units="rad/s")
