@@ -10,8 +10,8 @@ import json
 import sys
 from pathlib import Path
 
-from strapdown import bench
-from strapdown._io import write_text
+from strapdown.apps import bench
+from strapdown.io.files import write_text
 
 
 def main(argv: list[str] | None = None) -> int:

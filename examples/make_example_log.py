@@ -1,6 +1,6 @@
 import math
 import numpy as np
-from strapdown.motions import SpinConing
+from strapdown.truth.motions import SpinConing
 m = SpinConing(half_angle=math.radians(2.0), cone_rate=2 * math.pi * 3, spin_rate=math.radians(720))
 t = np.arange(4001) / 1000.0                      # 4 s at 1 kHz
 w = np.degrees(m.rate(t))                          # the log is in deg/s

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from strapdown import analysis
-from strapdown.evaluate import EvaluationConfig, evaluate
+from strapdown.analysis.evaluate import EvaluationConfig, evaluate
 from strapdown.reproduce.li2017 import drift_f64, drift_mp
 
 A_SMALL = 1e-6

@@ -8,14 +8,14 @@ import math
 import numpy as np
 import pytest
 
-import strapdown._ahrs_kernel as K
+import strapdown.ahrs._kernel as K
 from conftest import BROAD
-from strapdown.ahrs import Q_NED_ENU, AhrsConfig, attitude_from_acc_mag, ekf
-from strapdown.broad import broad_errors
-from strapdown.motions import SpinConing
+from strapdown.ahrs.filter import Q_NED_ENU, AhrsConfig, attitude_from_acc_mag, ekf
+from strapdown.analysis.broad import broad_errors
 from strapdown.rotation.dcm import dcm_from_quat
 from strapdown.rotation.error import attitude_error_angle
 from strapdown.rotation.quaternion import quat_multiply
+from strapdown.truth.motions import SpinConing
 
 ALGS = ["rate-single", "rate-three", "rate-three:structure=sliding", "rk4", "rotvec:N=3"]
 G_UP = np.array([0.0, 0.0, 9.80665])
@@ -90,7 +90,7 @@ def test_bias_is_estimated_at_rest_and_then_in_motion():
 
 
 def test_magnetic_anomaly_is_rejected_and_heading_recovers():
-    from strapdown import sensors
+    from strapdown.truth import sensors
 
     h = 1 / 100
     t = np.arange(int(80 / h)) * h
@@ -189,7 +189,7 @@ def test_broad_acceptance_against_fusion_and_vqf(tmp_path):
     """Mean total RMSE no worse than Fusion's; gating helps on the magnet trial."""
     pytest.importorskip("imufusion")
     pytest.importorskip("vqf")
-    from strapdown.ahrs_benchmark import benchmark, mean_total
+    from strapdown.apps.ahrs_benchmark import benchmark, mean_total
 
     res = benchmark(BROAD, tmp_path / "bench")
     ours, fusion, vqf = (mean_total(res, f) for f in ("strapdown EKF", "Fusion", "VQF"))

@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from strapdown import analysis as A
-from strapdown.motions import ClassicalConing
+from strapdown.analysis import accuracy as A
+from strapdown.truth.motions import ClassicalConing
 
 
 def test_drift_at_whole_periods_removes_periodic_part_exactly():

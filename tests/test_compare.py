@@ -7,10 +7,10 @@ import math
 import numpy as np
 import pytest
 
+from strapdown.analysis.evaluate import EvaluationConfig, evaluate
+from strapdown.apps.compare import compare_log, compare_motion, parse_spec
 from strapdown.cli import main
-from strapdown.compare import compare_log, compare_motion, parse_spec
-from strapdown.evaluate import EvaluationConfig, evaluate
-from strapdown.motions import SpinConing
+from strapdown.truth.motions import SpinConing
 
 
 def test_parse_spec():
@@ -54,8 +54,8 @@ def test_compare_log_against_truth(tmp_path, capsys):
     specs = ["rate-three", "rk4", "rate-single"]
     runs = compare_log(tmp_path / "log.csv", specs, tmp_path / "cmp", kind="rate",
                        units="rad/s", truth=tmp_path / "truth.npz")
+    from strapdown.algorithms.rate import rate_attitude
     from strapdown.analysis import attitude_errors
-    from strapdown.rate import rate_attitude
 
     for r, alg in zip(runs, specs, strict=True):
         sol = rate_attitude(t, w, algorithm=alg, q0=m.attitude(0.0))

@@ -9,10 +9,12 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
+from strapdown.algorithms.cone_kinematics import (
+    integrate_cone_angles,
+    integrate_cone_angles_reference,
+)
+from strapdown.algorithms.coning import TABLE7, triple_cross_rotation_vectors
 from strapdown.analysis import integrate_attitude_ode
-from strapdown.cone_kinematics import integrate_cone_angles, integrate_cone_angles_reference
-from strapdown.coning import TABLE7, triple_cross_rotation_vectors
-from strapdown.motions import ClassicalConing, ConeAngleMotion, SpinConing
 from strapdown.reproduce.zhang2021 import simulation
 from strapdown.rotation import (
     attitude_error_angle,
@@ -28,6 +30,7 @@ from strapdown.rotation.cone_angles import (
     paper_dcm_from_cone_angles,
     paper_pitch_yaw_from_cone_angles,
 )
+from strapdown.truth.motions import ClassicalConing, ConeAngleMotion, SpinConing
 
 D = math.radians
 

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from strapdown import coning as C
+from strapdown.algorithms import coning as C
 
 
 def _derive_optimum(n):

@@ -9,11 +9,11 @@ from fractions import Fraction as F
 import numpy as np
 import pytest
 
-from strapdown import design as D
+from strapdown.algorithms.coning import TABLE3, coefficient_set
+from strapdown.algorithms.precision import run_windowed_mp
 from strapdown.analysis import drift_rate
-from strapdown.coning import TABLE3, coefficient_set
-from strapdown.motions import ClassicalConing
-from strapdown.precision import run_windowed_mp
+from strapdown.design import designer as D
+from strapdown.truth.motions import ClassicalConing
 
 OMEGA = 2 * math.pi
 

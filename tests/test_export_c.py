@@ -10,11 +10,11 @@ import subprocess
 import numpy as np
 import pytest
 
-from strapdown import rate
-from strapdown.coning import coefficient_set
-from strapdown.export_c import export_c
-from strapdown.motions import SpinConing
-from strapdown.structures import conventional, realtime, single_chain
+from strapdown.algorithms import rate
+from strapdown.algorithms.coning import coefficient_set
+from strapdown.algorithms.structures import conventional, realtime, single_chain
+from strapdown.codegen.export_c import export_c
+from strapdown.truth.motions import SpinConing
 
 STEPS = 100_000
 H = 1e-4

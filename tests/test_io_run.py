@@ -9,12 +9,12 @@ import pytest
 from scipy.io import savemat
 
 from conftest import BROAD
+from strapdown.algorithms.coning import coefficient_set
+from strapdown.algorithms.structures import conventional, realtime
+from strapdown.apps.run import run_log
 from strapdown.cli import main
-from strapdown.coning import coefficient_set
 from strapdown.io import UnitWarning, read_imu
-from strapdown.motions import PureSpin, SpinConing
-from strapdown.run import run_log
-from strapdown.structures import conventional, realtime
+from strapdown.truth.motions import PureSpin, SpinConing
 
 
 def _csv(path, t, g, names=("t", "gx", "gy", "gz")):
@@ -72,7 +72,7 @@ def test_gaps_and_columns(tmp_path):
 
 @pytest.mark.parametrize("structure", ["conventional", "realtime", "single-chain"])
 def test_run_npy_streams_and_matches_one_shot(tmp_path, structure, monkeypatch):
-    import strapdown.run as run_mod
+    import strapdown.apps.run as run_mod
 
     monkeypatch.setattr(run_mod, "CHUNK", 777)  # many chunks
     m = SpinConing(0.05, 2 * math.pi, 20.0)
@@ -90,7 +90,7 @@ def test_run_npy_streams_and_matches_one_shot(tmp_path, structure, monkeypatch):
     elif structure == "realtime":
         ref = realtime(th, cs, h=h)
     else:
-        from strapdown.structures import single_chain
+        from strapdown.algorithms.structures import single_chain
 
         ref = single_chain(th, 3, h=h)
     assert np.array_equal(got[:, 1:5], ref.q)
@@ -220,7 +220,7 @@ def test_run_progress_bar_goes_to_stderr(tmp_path, capsys):
 
 
 def test_streamed_npy_reports_gaps_and_saturation(tmp_path, monkeypatch):
-    import strapdown.run as run_mod
+    import strapdown.apps.run as run_mod
 
     monkeypatch.setattr(run_mod, "CHUNK", 64)  # the gap and a saturated row in later chunks
     t = np.r_[np.arange(1, 101), np.arange(111, 201)] * 1e-3

@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 from conftest import quat_close
-from strapdown import motions as M
 from strapdown.analysis import integrate_attitude_ode
 from strapdown.rotation import attitude_error_angle, quat_multiply
+from strapdown.truth import motions as M
 
 CASES = [
     M.ClassicalConing(math.radians(1.0), 2 * math.pi),

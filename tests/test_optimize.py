@@ -8,8 +8,7 @@ import numpy as np
 import pytest
 
 from strapdown.design import interval_structure
-from strapdown.motions import ClassicalConing
-from strapdown.optimize import (
+from strapdown.design.optimize import (
     TransferCase,
     algorithm_from_groups,
     optimize,
@@ -17,6 +16,7 @@ from strapdown.optimize import (
     transfer,
     windowed_objective,
 )
+from strapdown.truth.motions import ClassicalConing
 
 OMEGA = 2 * math.pi
 

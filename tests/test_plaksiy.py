@@ -8,12 +8,11 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from strapdown import _reference
-from strapdown._backend import NUMPY
+from strapdown._core.backend import NUMPY
+from strapdown.algorithms import _reference
+from strapdown.algorithms.quaternion import QuaternionAlgorithm, quaternion_attitude
 from strapdown.analysis import accumulated_drift, integrate_attitude_ode
-from strapdown.evaluate import EvaluationConfig, evaluate
-from strapdown.motions import KrylovMotion, RotationSequenceMotion
-from strapdown.quaternion_algorithms import QuaternionAlgorithm, quaternion_attitude
+from strapdown.analysis.evaluate import EvaluationConfig, evaluate
 from strapdown.reproduce.plaksiy2024 import (
     K2,
     PRINTED_T1,
@@ -25,6 +24,7 @@ from strapdown.reproduce.plaksiy2024 import (
     K,
 )
 from strapdown.rotation import attitude_error_angle
+from strapdown.truth.motions import KrylovMotion, RotationSequenceMotion
 
 KS = [(0.15, 0.25, 0.05), (0.3, 0.5, 0.1), (0.4, 0.4, 0.0), (0.0, 0.7, 0.7), (1.3, -0.2, 2.1)]
 
@@ -99,8 +99,8 @@ def test_truncated_increment_is_eq7():
 
 
 def test_panov_equals_two_sample_rotation_vector_with_exact_exp():
-    from strapdown.coning import coefficient_set
-    from strapdown.structures import conventional
+    from strapdown.algorithms.coning import coefficient_set
+    from strapdown.algorithms.structures import conventional
 
     rng = np.random.default_rng(3)
     theta = rng.normal(size=(40, 3)) * 0.05
@@ -129,7 +129,7 @@ def test_table1_and_table3_reproduce(name):
 
 @pytest.mark.parametrize("name", ["miller", "panov", "power"])
 def test_our_optimiser_is_at_least_as_good(name):
-    from strapdown.optimize import optimize
+    from strapdown.design.optimize import optimize
 
     run = DriftRun(KrylovMotion(*K2), name)
     res = optimize(run.max_drift, np.array(_t2(name)), maxiter=200)

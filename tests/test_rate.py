@@ -7,11 +7,11 @@ import math
 import numpy as np
 import pytest
 
-from strapdown import _reference, rate
-from strapdown._backend import NUMPY
+from strapdown._core.backend import NUMPY
+from strapdown.algorithms import _reference, rate
+from strapdown.analysis.evaluate import EvaluationConfig, evaluate
 from strapdown.design import rk4_classical_coning_drift
-from strapdown.evaluate import EvaluationConfig, evaluate
-from strapdown.motions import SpinConing
+from strapdown.truth.motions import SpinConing
 
 A_SMALL_DEG = math.degrees(1e-9)
 

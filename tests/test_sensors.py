@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from strapdown import sensors as S
-from strapdown.motions import ClassicalConing, PureSpin
+from strapdown.truth import sensors as S
+from strapdown.truth.motions import ClassicalConing, PureSpin
 
 CONE = ClassicalConing(math.radians(1.0), 2 * math.pi)
 

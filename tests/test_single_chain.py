@@ -7,12 +7,12 @@ import math
 import numpy as np
 import pytest
 
-from strapdown import _reference
-from strapdown._backend import NUMPY
-from strapdown.coning import coefficient_set
-from strapdown.evaluate import EvaluationConfig, evaluate
+from strapdown._core.backend import NUMPY
+from strapdown.algorithms import _reference
+from strapdown.algorithms.coning import coefficient_set
+from strapdown.algorithms.structures import single_chain, single_chain_coefficients
+from strapdown.analysis.evaluate import EvaluationConfig, evaluate
 from strapdown.reproduce.li2017 import drift_mp
-from strapdown.structures import single_chain, single_chain_coefficients
 
 
 def test_matches_plain_reference_with_startup():
@@ -53,7 +53,7 @@ def test_float64_single_chain_at_one_degree():
 
 def test_single_chain_rejects_other_sets():
     with pytest.raises(ValueError, match="designer"):
-        from strapdown.structures import run_structure
+        from strapdown.algorithms.structures import run_structure
 
         run_structure("single-chain", np.zeros((5, 3)), coefficient_set("miller", 3), h=1e-3)
 

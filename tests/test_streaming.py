@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from strapdown.coning import coefficient_set
-from strapdown.streaming import RotvecStream
-from strapdown.structures import conventional, realtime, single_chain
+from strapdown.algorithms.coning import coefficient_set
+from strapdown.algorithms.streaming import RotvecStream
+from strapdown.algorithms.structures import conventional, realtime, single_chain
 
 
 def _chunks(theta, rng):

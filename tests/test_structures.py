@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from strapdown import _reference
-from strapdown._backend import NUMPY
-from strapdown.coning import coefficient_set, user_coefficients
-from strapdown.structures import conventional, realtime, startup_sets
+from strapdown._core.backend import NUMPY
+from strapdown.algorithms import _reference
+from strapdown.algorithms.coning import coefficient_set, user_coefficients
+from strapdown.algorithms.structures import conventional, realtime, startup_sets
 
 NAMES = [("table3", n) for n in range(1, 7)] + [("lag", 4), ("eq6-printed", 5), ("miller", 3),
                                                    ("none", 2)]

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from strapdown.sweep import cases, load_scenario, sweep
+from strapdown.apps.sweep import cases, load_scenario, sweep
 
 SCENARIO = textwrap.dedent("""
     algorithms = ["rotvec:N=2", "rotvec:N=3:structure=realtime", "rate-three", "rk4"]

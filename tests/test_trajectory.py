@@ -7,11 +7,11 @@ import math
 import numpy as np
 import pytest
 
-from strapdown import sensors
-from strapdown.rate import rate_attitude
+from strapdown.algorithms.rate import rate_attitude
 from strapdown.rotation.dcm import dcm_from_quat
 from strapdown.rotation.error import attitude_error_angle
-from strapdown.trajectory import (
+from strapdown.truth import sensors
+from strapdown.truth.trajectory import (
     WANG_VARIANTS,
     CoordinatedFlight,
     EarthField,

@@ -38,9 +38,11 @@ Data flows one way: motion → sensor → algorithm (coning correction + update
 structure) → analysis → report.
 """
 
-from strapdown import analysis, coning, motions, rotation, sensors, structures
-from strapdown.coning import CoefficientSet, coefficient_set, rotation_vectors
-from strapdown.structures import AttitudeSolution, conventional, realtime
+from strapdown import analysis, rotation
+from strapdown.algorithms import coning, structures
+from strapdown.algorithms.coning import CoefficientSet, coefficient_set, rotation_vectors
+from strapdown.algorithms.structures import AttitudeSolution, conventional, realtime
+from strapdown.truth import motions, sensors
 
 __version__ = "0.1.0"
 

@@ -27,14 +27,15 @@ from pathlib import Path
 
 import numpy as np
 
-from strapdown import analysis, sensors
-from strapdown._io import markdown_table, write_text
-from strapdown._report import ReportWriter, begin_report
+from strapdown import analysis
+from strapdown.algorithms.coning import TABLE3, coefficient_set, table1_drift_constant
+from strapdown.algorithms.precision import run_mp
+from strapdown.algorithms.structures import run_structure
 from strapdown.analysis import sawtooth_amplitude
-from strapdown.coning import TABLE3, coefficient_set, table1_drift_constant
-from strapdown.motions import ClassicalConing
-from strapdown.precision import run_mp
-from strapdown.structures import run_structure
+from strapdown.io.files import markdown_table, write_text
+from strapdown.io.report import ReportWriter, begin_report
+from strapdown.truth import sensors
+from strapdown.truth.motions import ClassicalConing
 
 F = Fraction
 
@@ -364,7 +365,7 @@ def reproduce(out: str | Path, *, progress: Callable[[str], None] | None = None)
 
 def _single_chain_section(w: ReportWriter) -> str:
     """What the paper wanted from the real-time structure, done by one chain."""
-    from strapdown.structures import single_chain_coefficients
+    from strapdown.algorithms.structures import single_chain_coefficients
 
     a1 = math.radians(1.0)
     rows = []

@@ -25,17 +25,17 @@ from pathlib import Path
 import numpy as np
 
 from strapdown import analysis
-from strapdown._io import write_text
-from strapdown._report import begin_report
-from strapdown.motions import ClassicalConing, KrylovMotion, Motion
-from strapdown.optimize import optimize
-from strapdown.quaternion_algorithms import (
+from strapdown.algorithms.quaternion import (
     ALGORITHMS,
     STATED,
     QuaternionAlgorithm,
     quaternion_attitude,
     subintervals,
 )
+from strapdown.design.optimize import optimize
+from strapdown.io.files import write_text
+from strapdown.io.report import begin_report
+from strapdown.truth.motions import ClassicalConing, KrylovMotion, Motion
 
 K = (0.15, 0.25, 0.05)
 K2 = tuple(2 * k for k in K)

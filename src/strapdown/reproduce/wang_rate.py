@@ -24,11 +24,13 @@ from pathlib import Path
 
 import numpy as np
 
-from strapdown import analysis, rate, sensors
-from strapdown._io import write_text
-from strapdown._report import ReportWriter, begin_report
-from strapdown.evaluate import EvaluationConfig, evaluate
-from strapdown.motions import ClassicalConing
+from strapdown import analysis
+from strapdown.algorithms import rate
+from strapdown.analysis.evaluate import EvaluationConfig, evaluate
+from strapdown.io.files import write_text
+from strapdown.io.report import ReportWriter, begin_report
+from strapdown.truth import sensors
+from strapdown.truth.motions import ClassicalConing
 
 A_SMALL = 1e-9
 SPP = (600, 240, 120, 60)

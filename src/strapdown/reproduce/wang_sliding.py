@@ -2,7 +2,7 @@
 
 ``strapdown reproduce wang-sliding --out DIR`` simulates the paper's flight
 (60 s straight east, then a coordinated circle; 250 s) in each consistent
-reading of its numbers (:func:`strapdown.trajectory.wang_circle`), generates
+reading of its numbers (:func:`strapdown.truth.trajectory.wang_circle`), generates
 gyro, accelerometer and magnetometer samples with a consumer-MEMS error
 model (seeded), and runs the AHRS EKF with the paper's three propagation
 algorithms:
@@ -33,16 +33,16 @@ from pathlib import Path
 
 import numpy as np
 
-from strapdown import sensors
-from strapdown._io import write_text
-from strapdown._report import begin_report
 from strapdown.ahrs import AhrsConfig, ekf
-from strapdown.motions import ClassicalConing
-from strapdown.rate import rate_attitude
+from strapdown.algorithms.rate import rate_attitude
+from strapdown.io.files import write_text
+from strapdown.io.report import begin_report
 from strapdown.rotation.dcm import dcm_from_quat
 from strapdown.rotation.euler import euler_zyx_from_dcm
 from strapdown.rotation.quaternion import quat_conjugate, quat_multiply, quat_rotate
-from strapdown.trajectory import WANG_VARIANTS, EarthField, wang_circle
+from strapdown.truth import sensors
+from strapdown.truth.motions import ClassicalConing
+from strapdown.truth.trajectory import WANG_VARIANTS, EarthField, wang_circle
 
 #: (label, propagation spec, update period in td) — the paper's algorithms 1–3
 FILTERS = [
@@ -120,7 +120,7 @@ def _aided(sim: Simulation, spec: str):
 
 def _open_loop(sim: Simulation, spec: str, gyro) -> float:
     """Max attitude error (rad) of the algorithm alone on the given gyro."""
-    from strapdown.compare import parse_spec
+    from strapdown.apps.compare import parse_spec
     from strapdown.rotation.error import attitude_error_angle
 
     f = parse_spec(spec)

@@ -17,16 +17,16 @@ from pathlib import Path
 import numpy as np
 
 from strapdown import analysis
-from strapdown._io import markdown_table, write_text
-from strapdown._report import ReportWriter, begin_report
-from strapdown.cone_kinematics import integrate_cone_angles
-from strapdown.coning import (
+from strapdown.algorithms.cone_kinematics import integrate_cone_angles
+from strapdown.algorithms.coning import (
     TABLE7,
     coefficient_set,
     rotation_vectors,
     triple_cross_rotation_vectors,
 )
-from strapdown.motions import ConeAngleMotion
+from strapdown.algorithms.structures import chain_rotation_vectors
+from strapdown.io.files import markdown_table, write_text
+from strapdown.io.report import ReportWriter, begin_report
 from strapdown.rotation.cone_angles import (
     cone_angles_from_dcm,
     cone_angles_from_quat,
@@ -37,7 +37,7 @@ from strapdown.rotation.cone_angles import (
     pitch_yaw_roll_from_cone_angles,
 )
 from strapdown.rotation.euler import euler_zyx_from_dcm
-from strapdown.structures import chain_rotation_vectors
+from strapdown.truth.motions import ConeAngleMotion
 
 D = math.radians
 RATE_HZ = 10_000.0

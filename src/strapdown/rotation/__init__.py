@@ -11,7 +11,7 @@ series (first omitted term below 3e-22 relative; the compiled kernels also take
 round-off from 1e-300 rad up to π.
 """
 
-from strapdown.rotation._series import SMALL_ANGLE
+from strapdown._core.series import SMALL_ANGLE
 from strapdown.rotation.cone_angles import (
     cone_angles_from_dcm,
     cone_angles_from_quat,

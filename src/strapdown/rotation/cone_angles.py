@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from strapdown._validation import as_dcms, as_quaternions, finite_array
+from strapdown._core.validation import as_dcms, as_quaternions, finite_array
 from strapdown.rotation.dcm import dcm_from_quat, quat_from_dcm
 from strapdown.rotation.euler import _rx, _rz, euler_zyx_from_dcm
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from strapdown._validation import as_dcms, as_quaternions
+from strapdown._core.validation import as_dcms, as_quaternions
 
 __all__ = ["dcm_from_quat", "quat_from_dcm"]
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from strapdown._validation import as_dcms, finite_array
+from strapdown._core.validation import as_dcms, finite_array
 
 __all__ = ["dcm_from_euler_zyx", "euler_zyx_from_dcm"]
 

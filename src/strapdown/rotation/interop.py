@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from strapdown._validation import as_quaternions
+from strapdown._core.validation import as_quaternions
 
 __all__ = ["quat_from_scipy", "scipy_from_quat"]
 

@@ -7,8 +7,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from strapdown._validation import as_quaternions, as_vectors
-from strapdown.rotation._series import SMALL_ANGLE, sinc
+from strapdown._core.series import SMALL_ANGLE, sinc
+from strapdown._core.validation import as_quaternions, as_vectors
 
 __all__ = [
     "quat_canonical",

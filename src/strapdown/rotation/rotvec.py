@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from strapdown._validation import as_vectors
-from strapdown.rotation._series import sinc
+from strapdown._core.series import sinc
+from strapdown._core.validation import as_vectors
 
 __all__ = ["dcm_from_rotvec", "f1_f2", "skew"]
 

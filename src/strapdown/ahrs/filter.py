@@ -1,0 +1,501 @@
+"""Attitude and heading reference: a multiplicative error-state EKF (seed 001, eqs. 30–35).
+
+The filter (Wang, Wang & Wang's attitude filter, made well-posed as
+papers.md describes):
+
+- **state** ``x = [δθ_b, δb_g, a_b]``: attitude error in the body frame
+  (``q_true = q̂ ⊗ q(δθ_b)``), gyro-bias error, and the manoeuvre
+  (non-gravitational) acceleration in the body frame as a first-order
+  Gauss–Markov (Singer) process ``ȧ = −a/τ + w``; optionally the
+  accelerometer bias ``δb_a`` (12 states, ``estimate_acc_bias``);
+- **propagation** of the attitude by any of the library's algorithms on the
+  bias-corrected gyro: ``rate-single``, ``rate-three`` (conventional or
+  ``structure=sliding``), ``rk4`` (step 2 td) and ``rotvec:N=…`` (on
+  increments formed from the rates by the trapezoid rule); covariance by
+  ``Φ = [[exp(−[φ×]), −T I, 0], [0, I, 0], [0, 0, e^{−T/τ} I]]``;
+- **updates** at every attitude output: a zero-rate update of the bias while
+  the sensor is at rest (gyro and accelerometer variance below thresholds),
+  the accelerometer ``f = C_b_n g_up + a_b`` (``H = [[v̂×], 0, I]``) and the
+  magnetometer as a heading measurement only (the heading of the field in the
+  reference frame, ``H = [−(C_n_b)₃ᵀ, 0, 0]``), so magnetic disturbances never
+  reach roll and pitch; Joseph form, sequential, then reset;
+- **gating**: an accelerometer or heading innovation whose NIS exceeds a χ²
+  threshold is rejected; a magnetometer sample whose norm or dip angle
+  departs from the reference field is rejected before that, and after a
+  magnetic disturbance the field must stay plausible for ``mag_settle_s``.
+  Recovery: when innovations keep failing the gate although the measurement
+  itself looks clean — the accelerometer quiet (low variance, norm g) for
+  ``recover_acc_s``, or a plausible field for ``recover_mag_s`` — the filter,
+  not the sensor, must be wrong: it inflates the affected covariance and
+  accepts again;
+- **initial attitude** from the mean accelerometer and magnetometer over
+  ``init_window_s`` (TRIAD) when none is given (the window is assumed at
+  rest); the reference field (norm, dip, heading) is learned there too,
+  unless given.
+
+Frames: the filter runs in ENU (x east, y north, z up); ``frame="NED"``
+returns q_NED_b. Heading is magnetic unless ``declination_deg`` is given.
+Without a magnetometer heading is not observed: it is the gyro's integral from
+the initial yaw (0 unless ``q0`` is given) and :attr:`AhrsResult.heading_observed`
+is False.
+
+The per-sample loop is :func:`strapdown.ahrs._kernel.ekf_kernel` (numba).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+from strapdown._core.validation import as_quaternions
+from strapdown.ahrs import _kernel as K
+from strapdown.rotation.quaternion import quat_multiply
+
+__all__ = ["AhrsConfig", "AhrsResult", "attitude_from_acc_mag", "ekf"]
+
+G = 9.80665
+#: q_NED_ENU: rotation by π about (1, 1, 0)/√2 (swaps x and y, flips z).
+Q_NED_ENU = np.array([0.0, math.sqrt(0.5), math.sqrt(0.5), 0.0])
+
+
+@dataclass(frozen=True)
+class AhrsConfig:
+    """Filter tuning (SI units). Defaults work on consumer MEMS IMUs at 100–1000 Hz.
+
+    Parameters
+    ----------
+    gyro_noise : float
+        Gyro white-noise density (angle random walk), rad/s/√Hz. Default 5e-4
+        (≈ 0.03 °/s/√Hz: a consumer MEMS gyro with margin for model error).
+    gyro_bias_rw : float
+        Bias random walk, rad/s/√s. Default 2e-5.
+    gyro_bias_sigma0 : float
+        Initial bias uncertainty, rad/s. Default 0.01 (0.6 °/s).
+    singer_sigma : float
+        Steady-state standard deviation of the manoeuvre acceleration, m/s². Default 2.
+    singer_tau : float
+        Its correlation time, s. Default 0.2.
+    acc_noise : float
+        Raw accelerometer model (``acc_model="raw"``): measurement noise
+        density (white noise plus vibration), m/s²/√Hz. Default 0.03. All
+        measurement noises are densities — an update every ``T`` s uses
+        ``R = density²/T`` — so the filter does not change with the
+        propagation algorithm's update period.
+    acc_model : {"lowpass", "raw"}
+        ``lowpass`` (default): the specific force rotated into the reference
+        frame and averaged over ``acc_lowpass_s`` is gravity — manoeuvre
+        accelerations average out (the idea of Laidig & Seel's VQF); the
+        Singer state is then unused. ``raw``: the paper's model, each sample
+        ``f = C_b_n g_up + a_b`` with the Singer state ``a_b``.
+    acc_lowpass_s : float
+        Averaging time constant, s. Default 3.
+    acc_lowpass_noise : float
+        Noise density of the averaged horizontal specific force, m/s²/√Hz.
+        Default 0.018.
+    acc_gate_lowpass : float
+        NIS gate of the averaged measurement (χ², 2 dof, 99.9 %: 13.82).
+    acc_gate_mode : {"hard", "soft"}
+        Beyond the gate: reject (hard, default) or de-weight (soft, Huber-type).
+    lever_arm : float
+        Raw model only: distance (m) from the centre of rotation used to widen
+        the accelerometer noise by the centripetal and tangential accelerations
+        the gyro sees. Default 0.1.
+    heading_noise : float
+        Magnetometer heading noise density, rad/√Hz. Default 0.018 (local
+        field distortion dominates the sensor noise indoors).
+    acc_gate, mag_gate : float
+        NIS thresholds (χ² with 3 and 1 degrees of freedom at 99.9 %: 16.27, 10.83).
+    mag_norm_tol : float
+        Reject a magnetometer sample whose norm departs from the reference by
+        more than this fraction. Default 0.1.
+    mag_dip_tol : float
+        … or whose dip angle departs by more than this, rad. Default 0.1 (5.7°).
+    acc_norm_tol : float
+        Raw model only: skip the accelerometer when its norm departs from g by
+        more than this fraction (sustained manoeuvres, impacts). Default 0.25.
+    mag_settle_s : float
+        After a magnetic disturbance, the field must stay plausible this long
+        before it is used again, s. Default 1.
+    recover_acc_s, recover_mag_s : float
+        Seconds of consecutive NIS rejections of clean-looking measurements
+        (accelerometer quiet; field plausible) after which the covariance is
+        inflated by ``recover_angle`` and measurements are accepted again.
+    recover_angle : float
+        Standard deviation added on recovery, rad. Default 0.1.
+    rest_gyro, rest_acc : float
+        Rest when the gyro's standard deviation over ``rest_tau`` is below
+        ``rest_gyro`` (rad/s) and its mean below 5 × that, and the
+        accelerometer's below ``rest_acc`` (m/s²). Defaults 0.01, 0.2.
+    rest_noise : float
+        Noise density of the zero-rate bias measurement, rad/s/√Hz. Default 1.2e-4.
+    rest_tau : float
+        Averaging time of the rest detector, s. Default 0.5.
+    estimate_acc_bias : bool
+        Add the accelerometer bias to the state (12 states). Off by default:
+        it is observable only through attitude changes, and a consumer IMU's
+        factory calibration usually leaves less than the filter can resolve.
+    acc_bias_sigma0 : float
+        Its initial uncertainty, m/s². Default 0.1.
+    acc_bias_rw : float
+        Its random walk, m/s²/√s. Default 1e-4.
+    gating : bool
+        Innovation gating and magnetic-disturbance rejection (default on).
+    rest_update : bool
+        Zero-rate bias updates at rest (default on).
+    use_accelerometer, use_magnetometer : bool
+        Switch the aiding off (the magnetometer is off anyway without data).
+    init_window_s : float
+        Averaging window for the initial attitude and the reference field, s.
+    attitude_sigma0 : float
+        Initial attitude uncertainty, rad. Default 0.05.
+    declination_deg : float
+        Magnetic declination (east positive); 0 gives a magnetic-north heading.
+    gravity : float
+        m/s². Default 9.80665.
+    """
+
+    gyro_noise: float = 5e-4
+    gyro_bias_rw: float = 2e-5
+    gyro_bias_sigma0: float = 0.01
+    singer_sigma: float = 2.0
+    singer_tau: float = 0.2
+    acc_noise: float = 0.03
+    heading_noise: float = 0.018
+    acc_gate: float = 16.27
+    mag_gate: float = 10.83
+    mag_norm_tol: float = 0.1
+    mag_dip_tol: float = 0.17
+    acc_model: str = "lowpass"
+    acc_lowpass_s: float = 3.0
+    acc_lowpass_noise: float = 0.018
+    acc_gate_lowpass: float = 13.82
+    acc_gate_mode: str = "hard"
+    lever_arm: float = 0.1
+    acc_norm_tol: float = 0.25
+    mag_settle_s: float = 2.0
+    recover_acc_s: float = 2.0
+    recover_mag_s: float = 10.0
+    recover_angle: float = 0.1
+    rest_gyro: float = 0.01
+    rest_acc: float = 0.2
+    rest_noise: float = 1.2e-4
+    rest_tau: float = 0.5
+    estimate_acc_bias: bool = False
+    acc_bias_sigma0: float = 0.1
+    acc_bias_rw: float = 1e-4
+    gating: bool = True
+    rest_update: bool = True
+    use_accelerometer: bool = True
+    use_magnetometer: bool = True
+    init_window_s: float = 0.5
+    attitude_sigma0: float = 0.05
+    declination_deg: float = 0.0
+    gravity: float = G
+
+    def __post_init__(self):
+        if self.acc_model not in ("lowpass", "raw"):
+            raise ValueError(f"AhrsConfig.acc_model must be 'lowpass' or 'raw', got "
+                             f"{self.acc_model!r}")
+        if self.acc_gate_mode not in ("soft", "hard"):
+            raise ValueError(f"AhrsConfig.acc_gate_mode must be 'soft' or 'hard', got "
+                             f"{self.acc_gate_mode!r}")
+        for name, v in asdict(self).items():
+            if isinstance(v, (bool, str)):
+                continue
+            if not math.isfinite(v):
+                raise ValueError(f"AhrsConfig.{name} must be finite, got {v!r}")
+            if name not in ("declination_deg", "lever_arm") and not v > 0:
+                raise ValueError(f"AhrsConfig.{name} must be positive, got {v!r}")
+
+
+@dataclass(frozen=True)
+class AhrsResult:
+    """Filter output at every attitude update.
+
+    Attributes
+    ----------
+    t : ndarray (m,)
+        Output times (s).
+    index : ndarray (m,)
+        Sample index of each output.
+    q : ndarray (m, 4)
+        q_n_b in :attr:`frame`.
+    frame : {"ENU", "NED"}
+    heading_observed : bool
+        False without a magnetometer (heading is the gyro's integral).
+    gyro_bias : ndarray (m, 3)
+        Estimated gyro bias, rad/s.
+    accel : ndarray (m, 3)
+        Estimated manoeuvre acceleration in the body frame, m/s².
+    flags : ndarray (m,) of int
+        Bit set per output (see ``strapdown.ahrs._kernel.F_*``).
+    nis : ndarray (m, 2)
+        Accelerometer and heading NIS (NaN where there was no update).
+    attitude_sigma : ndarray (m, 3)
+        Standard deviation of δθ_b, rad.
+    algorithm : str
+    acc_bias : ndarray (m, 3) or None
+        Estimated accelerometer bias, m/s² (with ``estimate_acc_bias``).
+    """
+
+    t: np.ndarray
+    index: np.ndarray
+    q: np.ndarray
+    frame: str
+    heading_observed: bool
+    gyro_bias: np.ndarray
+    accel: np.ndarray
+    flags: np.ndarray
+    nis: np.ndarray
+    attitude_sigma: np.ndarray
+    algorithm: str
+    config: AhrsConfig = field(repr=False, default_factory=AhrsConfig)
+    acc_bias: np.ndarray | None = None
+
+    def fraction(self, flag: int) -> float:
+        """Share of outputs with a flag set (e.g. ``K.F_MAG_USED``)."""
+        return float(np.mean((self.flags & flag) != 0)) if self.flags.size else math.nan
+
+
+def attitude_from_acc_mag(acc, mag=None, *, declination_deg: float = 0.0) -> np.ndarray:
+    """q_ENU_b from one specific-force vector (and a magnetic field vector), by TRIAD.
+
+    Up is the specific force at rest; north is the field's horizontal part
+    rotated by the declination. Without ``mag`` the yaw is zero (x_b's
+    horizontal projection points east).
+    """
+    f = np.asarray(acc, float)
+    if f.shape != (3,) or not np.all(np.isfinite(f)) or np.linalg.norm(f) == 0:
+        raise ValueError(f"acc must be a finite non-zero (3,) vector, got {f!r}")
+    up = f / np.linalg.norm(f)
+    if mag is None:
+        ref = np.array([1.0, 0.0, 0.0]) if abs(up[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+        east = ref - up * (ref @ up)
+        east /= np.linalg.norm(east)
+        north = np.cross(up, east)
+    else:
+        m = np.asarray(mag, float)
+        if m.shape != (3,) or not np.all(np.isfinite(m)):
+            raise ValueError(f"mag must be a finite (3,) vector, got {m!r}")
+        mh = m - up * (m @ up)
+        if np.linalg.norm(mh) < 1e-6 * max(np.linalg.norm(m), 1e-300):
+            raise ValueError("the magnetic field is vertical: heading is undefined")
+        mnorth = mh / np.linalg.norm(mh)
+        d = math.radians(declination_deg)
+        east_m = np.cross(mnorth, up)
+        north = math.cos(d) * mnorth - math.sin(d) * east_m
+        east = np.cross(north, up)
+    c_b_n = np.column_stack([east, north, up])  # columns: reference axes in body
+    from strapdown.rotation.dcm import quat_from_dcm
+
+    return quat_from_dcm(c_b_n.T)
+
+
+def _algorithm(spec: str):
+    """Kernel arguments for a propagation algorithm spec."""
+    from strapdown.apps.compare import parse_spec
+
+    f = parse_spec(spec)
+    alg = f["algorithm"]
+    structure = f.get("structure", "conventional")
+    coeffs = f.get("coefficients")
+    i0 = np.zeros(0, np.int64)
+    f0 = np.zeros(0)
+    from strapdown.algorithms import rate
+
+    if alg == "rk4":
+        if f.get("rk4_step", "2td") != "2td" or structure != "conventional" or coeffs:
+            raise ValueError("the filter's rk4 is the 2td step, conventional structure")
+        return dict(is_rate=True, offsets=i0, weights=f0, pi=i0, pj=i0, pc=f0, stride=2,
+                    span=2, end_off=2, lag=1, start_c=0.0, rk4=True)
+    if alg in ("rate-single", "rate-three"):
+        if alg == "rate-single":
+            w = rate.single_period_algorithm(coeffs or "derived")
+        else:
+            w = rate.three_period_algorithm(coeffs or "derived")
+        if structure not in rate.STRUCTURES[alg]:
+            raise ValueError(f"{alg} supports {', '.join(rate.STRUCTURES[alg])}, not {structure}")
+        sliding = structure == "sliding"
+        lag = w.span if sliding else 1
+        # the sliding scheme starts with single-period steps of the same coefficient set
+        start_c = (float(rate.single_period_algorithm(coeffs or "derived").pair_coefficients[0])
+                   if sliding else 0.0)
+        return dict(is_rate=True, offsets=np.array(w.offsets, np.int64),
+                    weights=np.array([float(x) for x in w.weights]),
+                    pi=np.array([p[0] for p in w.pairs], np.int64),
+                    pj=np.array([p[1] for p in w.pairs], np.int64),
+                    pc=np.array([float(c) for c in w.pair_coefficients]),
+                    stride=1 if sliding else w.update, span=w.span, end_off=w.span, lag=lag,
+                    start_c=start_c, rk4=False)
+    if alg == "rotvec":
+        from strapdown.algorithms.coning import coefficient_set
+
+        if structure != "conventional":
+            raise ValueError("the filter runs rotvec in the conventional structure")
+        n = f.get("subsamples", 3)
+        cs = coefficient_set(coeffs or "table3", n)
+        ii, jj = np.nonzero(cs.matrix)
+        return dict(is_rate=False, offsets=np.arange(n, dtype=np.int64), weights=np.ones(n),
+                    pi=ii.astype(np.int64), pj=jj.astype(np.int64), pc=cs.matrix[ii, jj],
+                    stride=n, span=n - 1, end_off=n, lag=1, start_c=0.0, rk4=False)
+    raise ValueError(f"the filter propagates with rate-single, rate-three (sliding), rk4 or "
+                     f"rotvec:N=…, not {alg!r}")
+
+
+def _params(cfg: AhrsConfig, ref, use_mag: bool) -> np.ndarray:
+    p = np.zeros(K.N_PARAMS)
+    p[K.P_GYRO_NOISE] = cfg.gyro_noise
+    p[K.P_BIAS_RW] = cfg.gyro_bias_rw
+    p[K.P_SINGER_SIGMA] = cfg.singer_sigma
+    p[K.P_SINGER_TAU] = cfg.singer_tau
+    p[K.P_ACC_NOISE] = cfg.acc_noise
+    p[K.P_HEADING_NOISE] = cfg.heading_noise
+    p[K.P_ACC_GATE] = cfg.acc_gate
+    p[K.P_MAG_GATE] = cfg.mag_gate
+    p[K.P_MAG_NORM_TOL] = cfg.mag_norm_tol
+    p[K.P_MAG_DIP_TOL] = cfg.mag_dip_tol
+    p[K.P_REF_NORM], p[K.P_REF_DIP], p[K.P_REF_HEADING] = ref
+    p[K.P_RECOVER_ACC] = cfg.recover_acc_s
+    p[K.P_RECOVER_MAG] = cfg.recover_mag_s
+    p[K.P_REST_GYRO] = cfg.rest_gyro
+    p[K.P_REST_ACC] = cfg.rest_acc
+    p[K.P_REST_NOISE] = cfg.rest_noise
+    p[K.P_REST_TAU] = cfg.rest_tau
+    p[K.P_USE_ACC] = float(cfg.use_accelerometer)
+    p[K.P_USE_MAG] = float(use_mag)
+    p[K.P_GATING] = float(cfg.gating)
+    p[K.P_USE_REST] = float(cfg.rest_update)
+    p[K.P_GRAVITY] = cfg.gravity
+    p[K.P_RECOVER_ANGLE] = cfg.recover_angle
+    p[K.P_ACC_NORM_TOL] = cfg.acc_norm_tol
+    p[K.P_MAG_SETTLE] = cfg.mag_settle_s
+    p[K.P_SOFT_ACC] = float(cfg.acc_gate_mode == "soft")
+    p[K.P_LEVER] = cfg.lever_arm
+    p[K.P_ACC_LP_TAU] = cfg.acc_lowpass_s if cfg.acc_model == "lowpass" else 0.0
+    p[K.P_ACC_LP_NOISE] = cfg.acc_lowpass_noise
+    p[K.P_ACC_GATE_LP] = cfg.acc_gate_lowpass
+    p[K.P_ACC_BIAS_RW] = cfg.acc_bias_rw
+    return p
+
+
+def _check(name, a, n):
+    a = np.ascontiguousarray(a, dtype=np.float64)
+    if a.shape != (n, 3):
+        raise ValueError(f"{name} must have shape ({n}, 3) to match the gyro, got {a.shape}")
+    bad = ~np.all(np.isfinite(a), axis=1)
+    if np.any(bad):
+        raise ValueError(f"{name} has NaN or infinity in row {int(np.argmax(bad))}")
+    return a
+
+
+def ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
+        config: AhrsConfig | None = None, q0=None, gyro_bias0=None,
+        mag_reference=None, frame: str = "ENU") -> AhrsResult:
+    """Run the AHRS filter over uniformly sampled gyro, accelerometer and magnetometer data.
+
+    Parameters
+    ----------
+    t : array_like (n,)
+        Sample times (s), uniform.
+    gyro : array_like (n, 3)
+        Body rates, rad/s.
+    acc : array_like (n, 3)
+        Specific force, m/s² (≈ +g up at rest).
+    mag : array_like (n, 3), optional
+        Magnetic field, any unit (µT typical). None: no heading (see the module docstring).
+    algorithm : str
+        Attitude propagation: ``rate-single`` (default), ``rate-three``,
+        ``rate-three:structure=sliding``, ``rk4``, ``rotvec:N=3`` …
+    config : AhrsConfig, optional
+    q0 : array_like (4,), optional
+        Initial q_n_b in ``frame``; default from the accelerometer and magnetometer.
+    gyro_bias0 : array_like (3,), optional
+        Initial bias estimate, rad/s (default zero).
+    mag_reference : array_like (3,), optional
+        The local magnetic field in ENU (same unit as ``mag``). Default: learned
+        over ``init_window_s`` — averaged at rest when ``q0`` is None, else
+        rotated into the reference frame along the gyro-propagated attitude.
+    frame : {"ENU", "NED"}
+    """
+    from strapdown.algorithms.rate import check_rate_record
+
+    cfg = config or AhrsConfig()
+    if frame not in ("ENU", "NED"):
+        raise ValueError(f"frame must be 'ENU' or 'NED', got {frame!r}")
+    rec = check_rate_record(t, gyro, min_samples=4)
+    n = rec.t.size
+    h = rec.td
+    acc = _check("acc", acc, n)
+    have_mag = mag is not None and cfg.use_magnetometer
+    mag = _check("mag", mag, n) if mag is not None else np.zeros((n, 3))
+    a_norm = np.median(np.linalg.norm(acc, axis=1))
+    if not 0.5 * cfg.gravity < a_norm < 2.0 * cfg.gravity:
+        raise ValueError(f"the accelerometer's median norm is {a_norm:.4g}; expected about "
+                         f"{cfg.gravity} m/s² (is it in g, or not specific force?)")
+    if have_mag and np.median(np.linalg.norm(mag, axis=1)) == 0:
+        raise ValueError("the magnetometer reads zero; pass mag=None for no heading")
+    w = max(2, min(n, round(cfg.init_window_s / h)))
+    if q0 is None:  # the initial window is assumed at rest: average it
+        f0 = acc[:w].mean(axis=0)
+        m0 = mag[:w].mean(axis=0) if have_mag else None
+    else:
+        f0 = acc[0]
+        m0 = mag[0] if have_mag else None
+    if q0 is None:
+        q_init = attitude_from_acc_mag(f0, m0, declination_deg=cfg.declination_deg)
+    else:
+        q_init = as_quaternions(q0, "q0").reshape(4)
+        q_init = q_init / np.linalg.norm(q_init)
+        if frame == "NED":  # the filter runs in ENU
+            q_init = quat_multiply(np.array([0.0, -Q_NED_ENU[1], -Q_NED_ENU[2], 0.0]), q_init)
+    from strapdown.rotation.dcm import dcm_from_quat
+
+    ref = (0.0, 0.0, 0.0)
+    if have_mag:
+        if mag_reference is not None:  # the local field is known (ENU)
+            mn = np.asarray(mag_reference, float)
+            if mn.shape != (3,) or not np.all(np.isfinite(mn)) or not np.linalg.norm(mn) > 0:
+                raise ValueError(f"mag_reference must be a finite non-zero (3,) ENU vector, "
+                                 f"got {mag_reference!r}")
+        elif q0 is None:
+            mn = dcm_from_quat(q_init) @ m0
+        else:  # learn the field over the window along the gyro-propagated attitude
+            from strapdown.algorithms.rate import rate_attitude
+
+            qw = rate_attitude(rec.t[:w], rec.omega[:w], algorithm="rate-single", q0=q_init).q
+            mn = np.einsum("nij,nj->ni", dcm_from_quat(qw), mag[:w]).mean(axis=0)
+        ref = (float(np.linalg.norm(mn)), math.atan2(-mn[2], math.hypot(mn[0], mn[1])),
+               math.atan2(mn[1], mn[0]))
+    b0 = np.zeros(3) if gyro_bias0 is None else _check("gyro_bias0", [gyro_bias0], 1)[0]
+    a = _algorithm(algorithm)
+    x = rec.omega if a["is_rate"] else 0.5 * h * (rec.omega[1:] + rec.omega[:-1])
+    nx = 12 if cfg.estimate_acc_bias else 9
+    P0 = np.zeros((nx, nx))
+    P0[:3, :3] = np.eye(3) * cfg.attitude_sigma0**2
+    P0[3:6, 3:6] = np.eye(3) * cfg.gyro_bias_sigma0**2
+    P0[6:9, 6:9] = np.eye(3) * cfg.singer_sigma**2
+    if nx == 12:
+        P0[9:, 9:] = np.eye(3) * cfg.acc_bias_sigma0**2
+    m = n  # at most one output per sample
+    out_q = np.empty((m, 4))
+    out_b = np.empty((m, 3))
+    out_a = np.empty((m, 3))
+    out_ab = np.empty((m, 3))
+    out_idx = np.empty(m, np.int64)
+    out_flags = np.empty(m, np.int64)
+    out_nis = np.empty((m, 2))
+    out_sig = np.empty((m, 3))
+    k = K.ekf_kernel(np.ascontiguousarray(x), a["is_rate"], h, a["offsets"], a["weights"],
+                     a["pi"], a["pj"], a["pc"], a["stride"], a["span"], a["end_off"], a["lag"],
+                     a["start_c"], a["rk4"], acc, mag, _params(cfg, ref, have_mag), q_init, b0,
+                     P0, out_q, out_b, out_a, out_ab, out_idx, out_flags, out_nis, out_sig)
+    q = out_q[:k]
+    if frame == "NED":
+        q = quat_multiply(Q_NED_ENU, q)
+    idx = out_idx[:k]
+    return AhrsResult(rec.t[idx], idx, q, frame, have_mag, out_b[:k], out_a[:k], out_flags[:k],
+                      out_nis[:k], out_sig[:k], algorithm, cfg,
+                      out_ab[:k] if cfg.estimate_acc_bias else None)
+

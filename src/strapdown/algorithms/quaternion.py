@@ -1,0 +1,101 @@
+"""Quaternion algorithms of the Ukrainian school on sub-interval increments (Plaksiy 2024).
+
+``miller`` (A1, eq. 5)
+    Thirds of the step: ``φ = θ* + α θ⁽¹⁾×θ⁽³⁾ + β θ⁽²⁾×(θ⁽³⁾ − θ⁽¹⁾)``; stated
+    ``α = 33/80, β = 57/80`` (Miller 1983).
+``panov`` (A2, eq. 6)
+    Halves: ``φ = θ* + α θ⁽⁴⁾×θ*``, ``θ⁽⁴⁾`` the first half; stated ``α = 2/3``.
+``power`` (A3, eq. 8)
+    Halves, no intermediate rotation vector: ``ΔΛ = [1 − θ*²/8 + θ*⁴/384,
+    ½θ*(1 − θ*²/24) + α θ⁽⁴⁾×θ*]``; stated ``α = 1/3``.
+
+A1 and A2 turn φ into the step quaternion with the truncated series of eq. 7
+(``1 − θ²/8 + θ⁴/384``, ``½θ(1 − θ²/24)``): a named algorithm choice, not the
+exponential map. ``exact_exp=True`` uses the exponential map instead (for A3:
+``exp(θ* + 2α θ⁽⁴⁾×θ*)``), separating truncation from coning error.
+``Λ_n = Λ_{n−1} ∘ ΔΛ_n`` without renormalisation, as in the paper.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from strapdown._core.validation import as_quaternions, as_vectors, finite_array, positive
+from strapdown.algorithms import _kernels
+from strapdown.algorithms.structures import AttitudeSolution
+
+__all__ = ["ALGORITHMS", "STATED", "QuaternionAlgorithm", "quaternion_attitude", "subintervals"]
+
+ALGORITHMS = ("miller", "panov", "power")
+#: Coefficients as the paper states them (α, β).
+STATED = {"miller": (33 / 80, 57 / 80), "panov": (2 / 3, 0.0), "power": (1 / 3, 0.0)}
+_MODE = {"miller": 1, "panov": 2, "power": 3}
+
+
+def subintervals(algorithm: str) -> int:
+    """Increments per step: 3 for Miller (thirds), 2 for Panov and power (halves)."""
+    if algorithm not in ALGORITHMS:
+        raise ValueError(f"unknown algorithm {algorithm!r}; choose one of {', '.join(ALGORITHMS)}")
+    return 3 if algorithm == "miller" else 2
+
+
+@dataclass(frozen=True)
+class QuaternionAlgorithm:
+    """One configured algorithm: name, coefficients, increment map."""
+
+    name: str
+    alpha: float
+    beta: float = 0.0
+    exact_exp: bool = False
+
+    def __post_init__(self):
+        subintervals(self.name)
+        finite_array([self.alpha, self.beta], "alpha/beta")
+        if self.name != "miller" and self.beta != 0.0:
+            raise ValueError(f"{self.name} has one coefficient (alpha); beta must be 0")
+
+    @classmethod
+    def stated(cls, name: str, *, exact_exp: bool = False) -> QuaternionAlgorithm:
+        """The paper's stated coefficients."""
+        subintervals(name)
+        a, b = STATED[name]
+        return cls(name, a, b, exact_exp)
+
+
+def quaternion_attitude(increments, algorithm: QuaternionAlgorithm, *, step: float,
+                        t0: float = 0.0, q0=None) -> AttitudeSolution:
+    """Run A1/A2/A3 on sub-interval increments.
+
+    Parameters
+    ----------
+    increments : array_like (M·s, 3)
+        Increments over the thirds (Miller, s = 3) or halves (s = 2) of each step.
+    algorithm : QuaternionAlgorithm
+    step : float
+        Computation step ΔT (s).
+    """
+    if not isinstance(algorithm, QuaternionAlgorithm):
+        raise ValueError("algorithm must be a QuaternionAlgorithm")
+    theta = as_vectors(increments, "increments")
+    if theta.ndim != 2:
+        raise ValueError(f"increments must have shape (n, 3), got {theta.shape}")
+    sub = subintervals(algorithm.name)
+    if theta.shape[0] < sub or theta.shape[0] % sub:
+        raise ValueError(f"{algorithm.name} needs whole steps of {sub} increments, "
+                         f"got {theta.shape[0]}")
+    step = positive(step, "step")
+    if q0 is None:
+        q0 = np.array([1.0, 0.0, 0.0, 0.0])
+    else:
+        q0 = as_quaternions(q0, "q0")
+        if q0.shape != (4,):
+            raise ValueError(f"q0 must have shape (4,), got {q0.shape}")
+    m = theta.shape[0] // sub
+    q = np.empty((m + 1, 4))
+    _kernels.quaternion_increment_kernel(np.ascontiguousarray(theta), _MODE[algorithm.name],
+                                         float(algorithm.alpha), float(algorithm.beta),
+                                         bool(algorithm.exact_exp), q0, q)
+    t = float(t0) + np.arange(m + 1) * step
+    return AttitudeSolution(t, q, algorithm.name, None, step / sub, step, np.zeros(m + 1, int))

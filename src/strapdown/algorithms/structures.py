@@ -1,0 +1,368 @@
+"""Update structures: how rotation vectors are chained into attitude.
+
+``conventional``
+    One attitude update per N increments, update period ``T = N h``
+    (Li & Zhang 2017 eq. 10, Figure 2).
+``realtime``
+    Li & Zhang 2017 eq. 15 (Figure 4): every ``h`` the rotation vector of the
+    last N increments updates the attitude of N samples earlier,
+    ``q(k) = q(k−N) ⊗ q(φ_k)``.
+
+    Start-up (the paper's "initial alignment" of the first N−1 outputs): for
+    ``k < N``, ``q(k) = q(0) ⊗ q(φ)`` where φ uses the k-subsample set on
+    increments 1 … k (by default the same family as the main set, or Table 3
+    when the family has no k-subsample member).
+
+    The structure is N interleaved conventional chains that never exchange
+    information (papers.md): it raises the output rate, not the accuracy.
+    :attr:`AttitudeSolution.chain` tells which chain produced each output.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from strapdown._core.validation import (
+    as_quaternions,
+    as_vectors,
+    finite_array,
+    positive,
+    positive_int,
+)
+from strapdown.algorithms import _kernels
+from strapdown.algorithms.coning import CoefficientSet, coefficient_set
+
+__all__ = [
+    "STRUCTURES",
+    "AttitudeSolution",
+    "chain_rotation_vectors",
+    "conventional",
+    "realtime",
+    "run_structure",
+    "single_chain",
+    "windowed",
+]
+
+STRUCTURES = ("conventional", "realtime", "single-chain")
+
+
+@dataclass(frozen=True)
+class AttitudeSolution:
+    """Time-stamped attitude from an update structure.
+
+    Attributes
+    ----------
+    t : ndarray of shape (m,)
+        Output times (s); ``t[0]`` is the initial time.
+    q : ndarray of shape (m, 4)
+        ``q_n_b`` at those times (unit, scalar first).
+    structure : str
+        ``"conventional"`` or ``"realtime"``.
+    coefficients : CoefficientSet or None
+        The coning correction used (None for designed/windowed algorithms).
+    h : float
+        Increment (subsample) interval (s).
+    update_period : float
+        Time between successive outputs (s).
+    chain : ndarray of shape (m,)
+        Index of the interleaved chain that produced each output (all 0 for
+        the conventional structure).
+    startup : int
+        Index of the first output in steady state: outputs before it precede
+        a start-up transient (N − 1 for the single chain, else 0). Drift is
+        measured from here on.
+    """
+
+    t: np.ndarray
+    q: np.ndarray
+    structure: str
+    coefficients: CoefficientSet | None
+    h: float
+    update_period: float
+    chain: np.ndarray
+    startup: int = 0
+
+    @property
+    def chains(self) -> int:
+        """Number of interleaved chains (N for the real-time structure, else 1)."""
+        return int(self.chain.max()) + 1 if self.chain.size else 1
+
+
+def _check_inputs(increments, coefficients, h, q0, t0):
+    if not isinstance(coefficients, CoefficientSet):
+        raise ValueError(
+            "coefficients must be a CoefficientSet (see strapdown.algorithms.coning.coefficient_set), "
+            f"got {type(coefficients).__name__}"
+        )
+    theta, h, t0, q0 = _stream_inputs(increments, "increments", h, t0, q0)
+    n = coefficients.n
+    if theta.shape[0] < n:
+        raise ValueError(
+            f"N = {n} subsamples need at least {n} increments, got {theta.shape[0]}"
+        )
+    return np.ascontiguousarray(theta), h, q0, t0
+
+
+def conventional(
+    increments,
+    coefficients: CoefficientSet,
+    *,
+    h: float,
+    t0: float = 0.0,
+    q0=None,
+    tail: str = "error",
+) -> AttitudeSolution:
+    """Conventional structure: an attitude update every ``T = N h``.
+
+    Parameters
+    ----------
+    increments : array_like of shape (n, 3)
+        Angular increments (rad) over consecutive intervals of length ``h``.
+    coefficients : CoefficientSet
+        Coning correction for N subsamples.
+    h : float
+        Increment interval (s).
+    t0 : float
+        Time of the first increment's start edge (s).
+    q0 : array_like of shape (4,), optional
+        Initial ``q_n_b`` (identity by default).
+    tail : {"error", "drop"}
+        What to do with increments that do not fill a last update.
+
+    Returns
+    -------
+    AttitudeSolution
+        ``n // N + 1`` outputs at ``t0 + j N h``.
+    """
+    theta, h, q0, t0 = _check_inputs(increments, coefficients, h, q0, t0)
+    n = coefficients.n
+    rest = theta.shape[0] % n
+    if rest:
+        if tail == "error":
+            raise ValueError(
+                f"{theta.shape[0]} increments do not fill whole updates of N = {n} "
+                f"({rest} left over); pass tail='drop' to discard them"
+            )
+        if tail != "drop":
+            raise ValueError(f"tail must be 'error' or 'drop', got {tail!r}")
+        theta = theta[: theta.shape[0] - rest]
+    m = theta.shape[0] // n
+    q = np.empty((m + 1, 4))
+    _kernels.conventional_kernel(theta, np.ascontiguousarray(coefficients.matrix), q0, q)
+    t = t0 + np.arange(m + 1) * (n * h)
+    return AttitudeSolution(t, q, "conventional", coefficients, h, n * h, np.zeros(m + 1, int))
+
+
+def startup_sets(coefficients: CoefficientSet) -> list[CoefficientSet]:
+    """The k-subsample sets (k = 1 … N−1) used by the real-time start-up, then the main set."""
+    out = []
+    for k in range(1, coefficients.n):
+        try:
+            out.append(coefficient_set(coefficients.name, k))
+        except ValueError:
+            out.append(coefficient_set("table3", k))
+    out.append(coefficients)
+    return out
+
+
+def stack_sets(sets: Sequence[CoefficientSet]) -> np.ndarray:
+    """Pack k-subsample matrices into the ``(N, N, N)`` array the real-time kernel reads."""
+    n = len(sets)
+    ks = np.zeros((n, n, n))
+    for k, s in enumerate(sets, start=1):
+        if s.n != k:
+            raise ValueError(f"start-up set {k} must have N = {k}, got N = {s.n}")
+        ks[k - 1, :k, :k] = s.matrix
+    return ks
+
+
+def realtime(
+    increments,
+    coefficients: CoefficientSet,
+    *,
+    h: float,
+    t0: float = 0.0,
+    q0=None,
+    startup: Sequence[CoefficientSet] | None = None,
+) -> AttitudeSolution:
+    """Li & Zhang 2017 real-time structure (eq. 15): an output every ``h``.
+
+    Parameters
+    ----------
+    increments, coefficients, h, t0, q0
+        As for :func:`conventional`.
+    startup : sequence of CoefficientSet, optional
+        The k-subsample sets for the first ``N − 1`` outputs, ``k = 1 … N−1``
+        (default: :func:`startup_sets`).
+
+    Returns
+    -------
+    AttitudeSolution
+        ``n + 1`` outputs at ``t0 + k h``; output ``k`` belongs to chain ``k mod N``.
+    """
+    theta, h, q0, t0 = _check_inputs(increments, coefficients, h, q0, t0)
+    n = coefficients.n
+    sets = startup_sets(coefficients) if startup is None else [*startup, coefficients]
+    ks = stack_sets(sets)
+    q = np.empty((theta.shape[0] + 1, 4))
+    _kernels.realtime_kernel(theta, ks, q0, q)
+    k = np.arange(theta.shape[0] + 1)
+    return AttitudeSolution(t0 + k * h, q, "realtime", coefficients, h, h, k % n)
+
+
+def run_structure(name: str, increments, coefficients, *, h, t0=0.0, q0=None) -> AttitudeSolution:
+    """Dispatch by structure name (``"conventional"`` or ``"realtime"``).
+
+    The conventional structure drops a tail of fewer than N increments here
+    (``tail="drop"``); call :func:`conventional` directly to have it refused.
+    """
+    if name == "conventional":
+        return conventional(increments, coefficients, h=h, t0=t0, q0=q0, tail="drop")
+    if name == "realtime":
+        return realtime(increments, coefficients, h=h, t0=t0, q0=q0)
+    if name == "single-chain":
+        if coefficients.name not in ("table3", "none"):
+            raise ValueError(
+                "the single chain takes its coefficients from the designer: use "
+                f"'table3' (the classical-coning optimum) or 'none', not {coefficients.name!r}"
+            )
+        n = coefficients.n if coefficients.name == "table3" else 1
+        return single_chain(increments, n, h=h, t0=t0, q0=q0)
+    raise ValueError(f"unknown structure {name!r}; choose one of {', '.join(STRUCTURES)}")
+
+
+def windowed(samples, algorithm, *, h: float, t0: float = 0.0, q0=None,
+             sliding: bool = False, startup=None) -> AttitudeSolution:
+    """Run a :class:`~strapdown.algorithms.coning.WindowedAlgorithm` on a sample stream.
+
+    Sample ``k`` is the increment over ``[t0 + k h, t0 + (k+1) h]`` or the rate
+    at ``t0 + k h``. The first ``algorithm.history`` samples only feed the
+    first windows: the initial attitude ``q0`` is at ``t0 + history·h``.
+
+    ``sliding=False``: an update every ``algorithm.update`` samples (one chain).
+    ``sliding=True`` (Wang et al.'s sliding scheme): an output every sample,
+    ``q(k) = q(k − U) ⊗ q(φ over [k − U, k])``; the first ``U − 1`` outputs come
+    from ``startup`` (a one-sample WindowedAlgorithm, e.g. the single-period
+    rate algorithm) chained from ``q0``. That is ``U`` interleaved chains.
+    """
+    from strapdown.algorithms.coning import WindowedAlgorithm
+
+    if not isinstance(algorithm, WindowedAlgorithm):
+        raise ValueError(f"algorithm must be a WindowedAlgorithm, got {type(algorithm).__name__}")
+    x, h, t0, q0 = _stream_inputs(samples, "samples", h, t0, q0)
+    return _windowed(np.ascontiguousarray(x), algorithm, h, t0, q0, sliding, startup)
+
+
+def _windowed(x, algorithm, h, t0, q0, sliding, startup) -> AttitudeSolution:
+    """:func:`windowed` on inputs already validated (C-contiguous float64, unit q0)."""
+    b0 = algorithm.history
+    last = x.shape[0] - 1 - algorithm.span  # largest admissible update start
+    if last < b0:
+        need = b0 + algorithm.span + 1
+        raise ValueError(f"{algorithm.name!r} needs at least {need} samples, got {x.shape[0]}")
+    u = algorithm.update
+    if not sliding:
+        starts = np.arange(b0, last + 1, u)
+        q = np.empty((starts.size + 1, 4))
+        q[0] = q0
+        _run_windowed(x, algorithm, h, starts, 1, q)
+        t = t0 + (b0 + np.arange(q.shape[0]) * u) * h
+        return AttitudeSolution(t, q, "windowed", None, h, u * h, np.zeros(t.size, int))
+    if startup is None or startup.update != 1:
+        raise ValueError("the sliding scheme needs a one-sample startup algorithm")
+    starts = np.arange(b0, last + 1)
+    q = np.empty((starts.size + u, 4))
+    q[0] = q0
+    if u > 1:
+        _run_windowed(x, startup, h, np.arange(b0, b0 + u - 1), 1, q[:u])
+    _run_windowed(x, algorithm, h, starts, u, q)
+    k = np.arange(q.shape[0])
+    return AttitudeSolution(t0 + (b0 + k) * h, q, "sliding", None, h, h, k % u)
+
+
+def _run_windowed(x, algorithm, h, starts, stride, q):
+    """Fused kernel call for a WindowedAlgorithm (rates scale α by h and β by h²)."""
+    sa, sb = (1.0, 1.0) if algorithm.input == "increment" else (h, h * h)
+    pairs = np.array(algorithm.pairs, dtype=np.int64).reshape(-1, 2)
+    _kernels.windowed_kernel(x, np.array(algorithm.offsets, dtype=np.int64),
+                             np.array([float(w) for w in algorithm.weights]),
+                             np.ascontiguousarray(pairs[:, 0]), np.ascontiguousarray(pairs[:, 1]),
+                             np.array([float(c) for c in algorithm.pair_coefficients]),
+                             sa, sb, np.asarray(starts, dtype=np.int64), stride, q)
+
+
+def single_chain_coefficients(n: int) -> tuple:
+    """Exact single-chain coefficients ``c_1 … c_{N−1}`` (classical-coning optimum, designer)."""
+    from strapdown.design import derive, single_chain_structure
+
+    return derive(single_chain_structure(n)).coefficients
+
+
+def single_chain_table(n: int) -> np.ndarray:
+    """Start-up and steady coefficients, shape (N, N − 1): row m holds c_1 … c_m of the
+    (m+1)-sample single-chain set (row N − 1 is the steady set)."""
+    n = positive_int(n, "N (subsamples)")
+    c = np.zeros((n, max(n - 1, 1)))
+    for m in range(1, n):
+        c[m, :m] = [float(x) for x in single_chain_coefficients(m + 1)]
+    return c
+
+
+def single_chain(increments, n: int, *, h: float, t0: float = 0.0, q0=None) -> AttitudeSolution:
+    """Single-chain high-rate structure: an attitude every h with N-subsample accuracy.
+
+    ``φ_k = θ_k + Σ_{m=1}^{N−1} c_m θ_{k−m} × θ_k``, ``q_k = q_{k−1} ⊗ q(φ_k)``,
+    coefficients from the designer (:func:`strapdown.design.single_chain_structure`),
+    ``c_m = (K_m − (N−m)/2)/N`` in terms of the conventional lag sums. Its
+    classical-coning drift equals the conventional N-subsample drift at the
+    same h, from one chain (no sawtooth). Start-up: increment k < N−1 uses the
+    (k+1)-sample set.
+    """
+    n = positive_int(n, "N (subsamples)")
+    theta = np.ascontiguousarray(as_vectors(increments, "increments"))
+    if theta.ndim != 2 or theta.shape[0] < 1:
+        raise ValueError(f"increments must have shape (n, 3) with n ≥ 1, got {theta.shape}")
+    h = positive(h, "h (sample interval)")
+    t0 = float(finite_array(t0, "t0"))
+    q0 = _unit_q0(q0)
+    q = np.empty((theta.shape[0] + 1, 4))
+    q[0] = q0
+    _kernels.single_chain_kernel(theta, single_chain_table(n), 0, 0, q)
+    t = t0 + np.arange(q.shape[0]) * h
+    return AttitudeSolution(t, q, "single-chain", None, h, h, np.zeros(t.size, int),
+                            min(n - 1, t.size - 1))
+
+
+def _stream_inputs(samples, name, h, t0, q0):
+    """Validated (samples (n, 3), h, t0, unit q0) of a sample-stream call."""
+    x = as_vectors(samples, name)
+    if x.ndim != 2:
+        raise ValueError(f"{name} must have shape (n, 3), got {x.shape}")
+    return (x, positive(h, "h (sample interval)"), float(finite_array(t0, "t0")),
+            _unit_q0(q0))
+
+
+def _unit_q0(q0) -> np.ndarray:
+    if q0 is None:
+        return np.array([1.0, 0.0, 0.0, 0.0])
+    q0 = as_quaternions(q0, "q0")
+    if q0.shape != (4,):
+        raise ValueError(f"q0 must have shape (4,), got {q0.shape}")
+    return q0 / np.linalg.norm(q0)
+
+
+def chain_rotation_vectors(phi, *, update_period: float, t0: float = 0.0,
+                           q0=None) -> AttitudeSolution:
+    """Chain precomputed body rotation vectors: ``q_k = q_{k−1} ⊗ q(φ_k)``."""
+    phi = as_vectors(phi, "phi")
+    if phi.ndim != 2:
+        raise ValueError(f"phi must have shape (n, 3), got {phi.shape}")
+    dt = positive(update_period, "update_period")
+    q0 = _unit_q0(q0)
+    q = np.empty((phi.shape[0] + 1, 4))
+    _kernels.chain_kernel(np.ascontiguousarray(phi), q0[None, :], 1, q)
+    t = float(finite_array(t0, "t0")) + np.arange(q.shape[0]) * dt
+    return AttitudeSolution(t, q, "chained", None, dt, dt, np.zeros(t.size, int))

@@ -1,0 +1,241 @@
+"""Several algorithms side by side, on one reference motion or on one log.
+
+An algorithm is named by a *spec*: the algorithm, then ``key=value`` options
+separated by colons — ``rotvec:N=3:structure=realtime``, ``rate-three:
+structure=sliding``, ``rk4:rk4_step=td-interp``, ``miller:step=0.01``. The keys
+are :class:`~strapdown.analysis.evaluate.EvaluationConfig` fields (``N`` is short for
+``subsamples``); an unknown key is an error that lists the known ones.
+
+On a motion, errors are against the exact truth. On a log there is no truth
+unless one is given (a ``t,qw,qx,qy,qz`` file); otherwise the first spec is
+the reference and the others are reported relative to it. Either way the
+reference is interpolated (slerp) to each algorithm's output times and only
+times inside the reference's span are compared.
+
+Output (a directory): ``error_vs_time.png``, ``summary.csv`` and ``summary.md``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from strapdown.analysis.evaluate import ALGORITHMS, RATE_ALGORITHMS, EvaluationConfig, evaluate
+from strapdown.io.report import begin_report
+
+__all__ = ["AlgorithmRun", "compare_log", "compare_motion", "parse_spec"]
+
+#: EvaluationConfig fields a spec may set (the algorithm and its options).
+SPEC_KEYS = ("subsamples", "coefficients", "structure", "rk4_step", "alpha", "beta", "step",
+             "exact_exp")
+_ALIASES = {"N": "subsamples", "n": "subsamples"}
+_INT = {"subsamples"}
+_FLOAT = {"alpha", "beta", "step"}
+_BOOL = {"exact_exp"}
+
+
+def parse_spec(spec: str) -> dict:
+    """``"rotvec:N=3:structure=realtime"`` → ``{"algorithm": "rotvec", "subsamples": 3, ...}``."""
+    if not isinstance(spec, str) or not spec.strip():
+        raise ValueError(f"an algorithm spec must be a non-empty string, got {spec!r}")
+    name, *opts = [p.strip() for p in spec.split(":")]
+    if name not in ALGORITHMS:
+        raise ValueError(f"spec {spec!r}: unknown algorithm {name!r}; choose one of "
+                         f"{', '.join(ALGORITHMS)}")
+    out: dict = {"algorithm": name}
+    for o in opts:
+        key, eq, value = o.partition("=")
+        key = _ALIASES.get(key.strip(), key.strip())
+        if not eq or key not in SPEC_KEYS:
+            raise ValueError(f"spec {spec!r}: {o!r} is not key=value with a key among "
+                             f"N, {', '.join(SPEC_KEYS)}")
+        value = value.strip()
+        try:
+            if key in _INT:
+                out[key] = int(value)
+            elif key in _FLOAT:
+                out[key] = float(value)
+            elif key in _BOOL:
+                if value.lower() not in ("true", "false", "1", "0"):
+                    raise ValueError(value)
+                out[key] = value.lower() in ("true", "1")
+            else:
+                out[key] = value
+        except ValueError:
+            raise ValueError(f"spec {spec!r}: bad value {value!r} for {key}") from None
+    return out
+
+
+@dataclass(frozen=True)
+class AlgorithmRun:
+    """One algorithm's error history and summary (rad, s)."""
+
+    label: str
+    t: np.ndarray
+    angle: np.ndarray
+    summary: dict
+
+
+def _summary_row(label, t, angle, update_period, extra=None) -> dict:
+    row = {"algorithm": label, "update_period_s": update_period, "outputs": int(t.size),
+           "max_error_rad": float(np.max(angle)) if angle.size else math.nan,
+           "rms_error_rad": float(np.sqrt(np.mean(angle**2))) if angle.size else math.nan,
+           "final_error_rad": float(angle[-1]) if angle.size else math.nan}
+    row.update(extra or {})
+    return row
+
+
+def compare_motion(base: EvaluationConfig, specs, out, *, progress=None) -> list[AlgorithmRun]:
+    """Run every spec on ``base``'s motion and sensor; write the figure and tables to ``out``."""
+    specs = list(specs)
+    if not specs:
+        raise ValueError("give at least one algorithm spec")
+    runs = []
+    for spec in specs:
+        cfg = dataclasses.replace(base, **parse_spec(spec))
+        ev = evaluate(cfg)
+        d = ev.to_dict()
+        ratio = (d["cone_axis_drift_rad_s"] / d["predicted_drift_rad_s"]
+                 if d["predicted_drift_rad_s"] and d["cone_axis_drift_rad_s"] is not None
+                 else None)
+        runs.append(AlgorithmRun(spec, ev.t, ev.angle, _summary_row(
+            spec, ev.t, ev.angle, ev.update_period,
+            {"cone_axis_drift_rad_s": d["cone_axis_drift_rad_s"],
+             "predicted_drift_rad_s": d["predicted_drift_rad_s"], "measured_over_law": ratio})))
+    title = (f"{base.motion}, half angle {base.half_angle_deg}°, cone {base.cone_rate_hz} Hz, "
+             f"spin {base.spin_rate_dps} °/s, {base.sample_rate_hz:g} Hz gyro")
+    _write(out, runs, title, "error against the exact truth", progress)
+    return runs
+
+
+def _read_truth(path) -> tuple[np.ndarray, np.ndarray]:
+    path = Path(path)
+    if path.suffix.lower() == ".npz":
+        with np.load(path) as z:
+            missing = [k for k in ("t", "qw", "qx", "qy", "qz") if k not in z]
+            if missing:
+                raise ValueError(f"{path}: truth needs arrays t, qw, qx, qy, qz; missing "
+                                 f"{missing}")
+            return np.asarray(z["t"], float), np.column_stack(
+                [np.asarray(z[k], float) for k in ("qw", "qx", "qy", "qz")])
+    with open(path, encoding="utf-8") as f:
+        header = [c.strip() for c in f.readline().split(",")]
+    missing = [k for k in ("t", "qw", "qx", "qy", "qz") if k not in header]
+    if missing:
+        raise ValueError(f"{path}: truth needs columns t, qw, qx, qy, qz; missing {missing}")
+    arr = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+    cols = [header.index(k) for k in ("t", "qw", "qx", "qy", "qz")]
+    return arr[:, cols[0]], arr[:, cols[1:]]
+
+
+def _errors_against(t_ref, q_ref, t, q) -> tuple[np.ndarray, np.ndarray]:
+    """Angle between ``q`` and the reference slerped to ``t`` (inside the reference span)."""
+    from scipy.spatial.transform import Slerp
+
+    from strapdown.rotation.error import attitude_error_angle
+    from strapdown.rotation.interop import quat_from_scipy, scipy_from_quat
+
+    inside = (t >= t_ref[0]) & (t <= t_ref[-1])
+    if not np.any(inside):
+        return t[:0], np.empty(0)
+    ref = quat_from_scipy(Slerp(t_ref, scipy_from_quat(q_ref))(t[inside]))
+    return t[inside], attitude_error_angle(q[inside], ref)
+
+
+def _run_on_log(log, fields, q0):
+    from strapdown.algorithms import rate
+    from strapdown.algorithms.coning import coefficient_set
+    from strapdown.algorithms.structures import run_structure
+
+    alg = fields["algorithm"]
+    structure = fields.get("structure", "conventional")
+    if alg in RATE_ALGORITHMS:
+        if log.kind != "rate":
+            raise ValueError(f"{alg} takes rate samples; this log holds increments")
+        sol = rate.rate_attitude(log.t, log.data, algorithm=alg, structure=structure,
+                                 coefficients=fields.get("coefficients") or "derived",
+                                 rk4_step=fields.get("rk4_step", "2td"), q0=q0)
+        return sol, rate.update_period(alg, log.h, structure=structure,
+                                       rk4_step=fields.get("rk4_step", "2td"))
+    if alg != "rotvec":
+        raise ValueError(f"{alg} runs on reference motions only (its input is the Krylov model's "
+                         "increments at thirds or halves of a step); use rotvec or a rate "
+                         "algorithm on a log")
+    if log.kind != "increment":
+        raise ValueError("rotvec takes increments; this log holds rates")
+    n = fields.get("subsamples", 3)
+    cs = coefficient_set(fields.get("coefficients") or "table3", n)
+    sol = run_structure(structure, log.data, cs, h=log.h, t0=float(log.t[0]) - log.h, q0=q0)
+    from strapdown.analysis import update_period
+
+    return sol, update_period(structure, n, log.h)
+
+
+def compare_log(imu, specs, out, *, kind: str, units: str | None,
+                columns=("t", "gx", "gy", "gz"), sample_rate_hz=None, truth=None,
+                progress=None) -> list[AlgorithmRun]:
+    """Run every spec on one gyro log and compare them (see the module docstring)."""
+    from strapdown.io import read_imu
+
+    specs = list(specs)
+    if not specs:
+        raise ValueError("give at least one algorithm spec")
+    fields = [parse_spec(s) for s in specs]
+    log = read_imu(imu, kind=kind, units=units, columns=columns, sample_rate_hz=sample_rate_hz)
+    q0 = None
+    if truth is not None:
+        t_ref, q_ref = _read_truth(truth)
+        from scipy.spatial.transform import Slerp
+
+        from strapdown.rotation.interop import quat_from_scipy, scipy_from_quat
+
+        t_start = float(log.t[0]) - (log.h if kind == "increment" else 0.0)
+        if not t_ref[0] <= t_start <= t_ref[-1]:
+            raise ValueError(f"{truth}: covers t = {t_ref[0]}…{t_ref[-1]} s, not the log's start "
+                             f"{t_start} s")
+        q0 = quat_from_scipy(Slerp(t_ref, scipy_from_quat(q_ref))([t_start]))[0]
+    sols = [_run_on_log(log, f, q0) for f in fields]
+    if truth is None:
+        t_ref, q_ref = sols[0][0].t, sols[0][0].q
+        what = f"difference from {specs[0]} (no truth given)"
+    else:
+        what = f"error against {Path(truth).name}"
+    runs = []
+    for spec, (sol, period) in zip(specs, sols, strict=True):
+        t, ang = _errors_against(t_ref, q_ref, sol.t, sol.q)
+        runs.append(AlgorithmRun(spec, t, ang, _summary_row(spec, t, ang, period)))
+    _write(out, runs, f"{Path(imu).name}: {log.t.size} {kind} samples at {1 / log.h:g} Hz",
+           what, progress)
+    return runs
+
+
+def _write(out, runs, title, what, progress) -> None:
+    out, writer, say, plt, _ = begin_report(out, progress)
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    for r in runs:
+        if r.angle.size and np.any(r.angle > 0):
+            ax.semilogy(r.t, np.where(r.angle > 0, r.angle, np.nan), lw=0.8, label=r.label)
+        else:
+            ax.plot([], [], label=f"{r.label} (identically zero)")
+    ax.set_xlabel("t (s)")
+    ax.set_ylabel("attitude error angle (rad)")
+    ax.set_title(f"{title}\n{what}", fontsize=9)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    writer.figure("error_vs_time.png", fig)
+    header = list(runs[0].summary)
+    for r in runs[1:]:
+        header += [k for k in r.summary if k not in header]
+
+    def cell(v):
+        if v is None or (isinstance(v, float) and math.isnan(v)):
+            return ""
+        return f"{v:.6e}" if isinstance(v, float) else v
+
+    rows = [[cell(r.summary.get(k)) for k in header] for r in runs]
+    writer.table("summary", header, rows)
+    say(f"wrote {out}/summary.md, summary.csv, error_vs_time.png ({what})")

@@ -1,0 +1,218 @@
+"""``strapdown run``: attitude from a user's gyro log, streamed, written atomically.
+
+Increment logs run through :class:`strapdown.algorithms.streaming.RotvecStream` in chunks
+(``.npy`` logs are memory-mapped, so files larger than memory stream with O(1)
+memory); rate logs run through :func:`strapdown.algorithms.rate.rate_attitude`. Output:
+``t, qw, qx, qy, qz`` plus yaw/pitch/roll (deg, z-y-x) or cone angles (deg),
+as CSV or ``.npz``. Nothing is written when the input fails validation, and
+the input file is never overwritten.
+"""
+
+from __future__ import annotations
+
+import sys
+import warnings
+from pathlib import Path
+
+import numpy as np
+from tqdm import tqdm
+
+from strapdown._core.validation import first_bad_step
+from strapdown.algorithms.coning import coefficient_set
+from strapdown.algorithms.streaming import RotvecStream
+from strapdown.io import read_imu
+from strapdown.io.files import atomic_path
+from strapdown.rotation.cone_angles import cone_angles_from_quat
+from strapdown.rotation.dcm import dcm_from_quat
+from strapdown.rotation.euler import euler_zyx_from_dcm
+
+__all__ = ["run_log"]
+
+CHUNK = 1 << 16
+
+
+def _angles(q, kind):
+    if kind == "ypr":
+        y, p, r = euler_zyx_from_dcm(dcm_from_quat(q))
+        return {"yaw_deg": np.degrees(y), "pitch_deg": np.degrees(p), "roll_deg": np.degrees(r)}
+    if kind == "cone":
+        d1, d2, d3 = cone_angles_from_quat(q)
+        return {"delta1_deg": np.degrees(d1), "delta2_deg": np.degrees(d2),
+                "delta3_deg": np.degrees(d3)}
+    return {}
+
+
+def _rows(t, q, angles):
+    cols = [t, q[:, 0], q[:, 1], q[:, 2], q[:, 3], *_angles(q, angles).values()]
+    return np.column_stack(cols)
+
+
+def _header(angles):
+    names = ["t", "qw", "qx", "qy", "qz", *_angles(np.array([[1.0, 0, 0, 0]]), angles)]
+    return ",".join(names)
+
+
+def _npy_chunks(path: Path, units: str, read: dict, gaps: list, saturated: list):
+    """Validated (t, increments) chunks of an (n, 4) .npy log, memory-mapped.
+
+    Gaps (intervals over ``gap_tolerance`` times the first interval — a
+    streamed log has no median) and saturated rows are appended to ``gaps``
+    and ``saturated`` as the chunks go by; ``on_gap="error"`` raises at the first gap.
+    """
+    arr = np.load(path, mmap_mode="r")
+    if arr.ndim != 2 or arr.shape[1] != 4:
+        raise ValueError(f"{path}: .npy logs must be (n, 4) [t, gx, gy, gz], got {arr.shape}")
+    scale = np.pi / 180.0 if units == "deg" else 1.0
+    last = None
+    h = None
+    for s in range(0, arr.shape[0], CHUNK):
+        c = np.array(arr[s:s + CHUNK], dtype=np.float64)
+        bad = ~np.all(np.isfinite(c), axis=1)
+        if np.any(bad):
+            raise ValueError(f"{path}: NaN or infinity in data row {s + int(np.argmax(bad)) + 1}")
+        t = c[:, 0] if last is None else np.concatenate([[last], c[:, 0]])
+        d = np.diff(t)
+        first = 1 if last is None else 0  # data row (1-based) of t[0] is s + first
+        fault = first_bad_step(d)
+        if fault is not None:
+            i, what = fault
+            raise ValueError(f"{path}: {what} time stamp in data row {s + i + first + 1}")
+        if h is None and d.size:
+            h = float(d[0])
+        if h is not None:
+            for i in np.flatnonzero(d > read["gap_tolerance"] * h):
+                row = s + int(i) + first + 1
+                if read["on_gap"] == "error":
+                    raise ValueError(f"{path}: gap of {d[i]:.6g} s ({d[i] / h:.1f} sample "
+                                     f"intervals) before data row {row}")
+                gaps.append(row)
+        if read["saturation"] is not None:
+            hit = np.flatnonzero(np.any(np.abs(c[:, 1:]) >= read["saturation"], axis=1))
+            saturated.extend(int(s + i + 1) for i in hit)
+        last = c[-1, 0]
+        yield c[:, 0], c[:, 1:] * scale
+
+
+def run_log(imu, out, *, kind: str, units: str | None, algorithm: str = "rotvec",
+            structure: str = "conventional", subsamples: int = 3, coefficients=None,
+            columns=("t", "gx", "gy", "gz"), sample_rate_hz=None, angles: str = "ypr",
+            q0=None, on_gap: str = "report", gap_tolerance: float = 1.5,
+            saturation: float | None = None, progress: bool = False) -> dict:
+    """Process a log; returns a summary (samples, outputs, gaps, saturated rows, warnings).
+
+    Parameters
+    ----------
+    on_gap : {"report", "error", "split"}
+        ``split`` runs each gap-free segment separately (each starting from the
+        previous segment's last attitude, no increment or rate spanning the gap)
+        and adds a ``segment`` column.
+    saturation : float, optional
+        Sensor range in the declared unit; saturated rows are reported.
+    progress : bool
+        Show a progress bar (tqdm, on stderr).
+    """
+    imu, out = Path(imu), Path(out)
+    if out.resolve() == imu.resolve():
+        raise ValueError("--out must not be the input file")
+    if out.suffix.lower() not in (".csv", ".npz"):
+        raise ValueError(f"{out}: output must be .csv or .npz")
+    if angles not in ("ypr", "cone", "none"):
+        raise ValueError(f"angles must be ypr, cone or none, got {angles!r}")
+    if on_gap not in ("report", "error", "split"):
+        raise ValueError(f"on_gap must be report, error or split, got {on_gap!r}")
+    if algorithm == "rotvec" and kind != "increment":
+        raise ValueError("rotvec takes increments (--increments); for rate logs use "
+                         "rate-single, rate-three or rk4")
+    if algorithm != "rotvec" and kind != "rate":
+        raise ValueError(f"{algorithm} takes rate samples (--rates)")
+    read = {"kind": kind, "units": units, "columns": columns, "sample_rate_hz": sample_rate_hz,
+            "gap_tolerance": gap_tolerance, "on_gap": "error" if on_gap == "error" else "report",
+            "saturation": saturation}
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        if algorithm != "rotvec":
+            res = _run_rates(imu, out, read, algorithm, structure, coefficients, angles, q0,
+                             on_gap == "split")
+        else:
+            res = _run_increments(imu, out, read, structure, coefficient_set(
+                coefficients or "table3", subsamples), angles, q0, on_gap == "split", progress)
+    res["warnings"] = [str(w.message) for w in caught]
+    return res
+
+
+def _run_increments(imu, out, read, structure, cs, angles, q0, split, progress):
+    if imu.suffix.lower() == ".npy" and not split:
+        if read["units"] is None:
+            raise ValueError(f"{imu}: .npy logs carry no units; pass --units")
+        total = np.load(imu, mmap_mode="r").shape[0]
+        gaps: list = []
+        saturated: list = []
+        segments = [_npy_chunks(imu, read["units"], read, gaps, saturated)]
+        h_log = 1.0
+    else:
+        log = read_imu(imu, **read)
+        total, gaps, saturated, h_log = log.t.size, log.gaps, log.saturated, log.h
+        cuts = log.segments() if split else [slice(0, log.t.size)]
+        segments = [((log.t[c][s:s + CHUNK], log.data[c][s:s + CHUNK])
+                     for s in range(0, c.stop - c.start, CHUNK)) for c in cuts]
+    csv_out = out.suffix.lower() == ".csv"
+    names = _header(angles).split(",") + (["segment"] if split else [])
+    n_in = n_out = 0
+    q_last = q0
+    with atomic_path(out) as tmp, tqdm(total=total, disable=not progress, unit="sample",
+                                       unit_scale=True, file=sys.stderr) as bar:
+        parts = []
+        with open(tmp, "w", encoding="utf-8") as f:
+            if csv_out:
+                f.write(",".join(names) + "\n")
+            for k, chunks in enumerate(segments):
+                stream = None
+                for t, th in chunks:
+                    if stream is None:
+                        h = float(t[1] - t[0]) if t.size > 1 else h_log
+                        stream = RotvecStream(structure, cs, h=h, t0=float(t[0]) - h, q0=q_last)
+                    res = stream.feed(th)
+                    n_in += th.shape[0]
+                    bar.update(th.shape[0])
+                    if res.q.shape[0]:
+                        rows = _rows(res.t, res.q, angles)
+                        if split:
+                            rows = np.column_stack([rows, np.full(rows.shape[0], float(k))])
+                        n_out += rows.shape[0]
+                        if csv_out:
+                            np.savetxt(f, rows, delimiter=",", fmt="%.17g")
+                        else:
+                            parts.append(rows)
+                        q_last = res.q[-1]
+        if n_in == 0:
+            raise ValueError(f"{imu}: no samples")
+        if not csv_out:
+            table = np.concatenate(parts) if parts else np.empty((0, len(names)))
+            with open(tmp, "wb") as f:
+                np.savez(f, **{k: table[:, i] for i, k in enumerate(names)})
+    return {"samples": n_in, "outputs": n_out, "gaps": gaps, "saturated": saturated}
+
+
+def _run_rates(imu, out, read, algorithm, structure, coefficients, angles, q0, split):
+    from strapdown.algorithms import rate
+    from strapdown.io import write_attitude
+
+    log = read_imu(imu, **read)
+    cuts = log.segments() if split else [slice(0, log.t.size)]
+    ts, qs, segs = [], [], []
+    q_last = q0
+    for k, c in enumerate(cuts):
+        sol = rate.rate_attitude(log.t[c], log.data[c], algorithm=algorithm,
+                                 structure=structure, coefficients=coefficients or "derived",
+                                 q0=q_last)
+        ts.append(sol.t)
+        qs.append(sol.q)
+        segs.append(np.full(sol.t.size, float(k)))
+        q_last = sol.q[-1]
+    t, q = np.concatenate(ts), np.concatenate(qs)
+    extra = _angles(q, angles)
+    if split:
+        extra["segment"] = np.concatenate(segs)
+    write_attitude(out, t, q, extra=extra)
+    return {"samples": int(log.t.size), "outputs": int(t.size), "gaps": log.gaps,
+            "saturated": log.saturated}

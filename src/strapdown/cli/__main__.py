@@ -1,0 +1,5 @@
+import sys
+
+from strapdown.cli import main
+
+sys.exit(main())

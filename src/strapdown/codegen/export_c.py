@@ -1,0 +1,466 @@
+"""Generate self-contained, allocation-free C99 for a configured attitude algorithm.
+
+``strapdown export-c --algorithm rotvec|rate-single|rate-three|rk4 ... --out DIR``
+writes ``<name>.h`` and ``<name>.c``: a state struct, ``<name>_init``,
+``<name>_reset`` and ``<name>_update`` (one increment or rate sample in; the
+attitude quaternion out, return value 1, whenever an update completes). No
+dynamic allocation; from libm only ``sqrt``, ``sin`` and ``cos``. Coefficients
+are baked in as decimal literals with their exact rational form in a
+comment. The C mirrors :mod:`strapdown.algorithms._kernels` operation by operation
+(same small-angle series, same summation order), so in double precision it
+matches the Python library to round-off.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from fractions import Fraction
+from pathlib import Path
+
+from strapdown._core.series import SMALL_ANGLE
+from strapdown._core.validation import positive, positive_int
+from strapdown.algorithms.coning import coefficient_set
+from strapdown.io.files import write_text
+
+__all__ = ["ALGORITHMS", "CExport", "export_c", "generate"]
+
+ALGORITHMS = ("rotvec", "rate-single", "rate-three", "rk4")
+_CITE = {
+    "rotvec": "Li & Zhang 2017, J. Control Sci. Eng. 9542423: eq. 6 (pair form), eq. 9 "
+              "(rotation vector), eq. 10 (conventional), eq. 15 (real-time); single chain: "
+              "strapdown designer (c_m = (K_m - (N-m)/2)/N)",
+    "rate-single": "Wang, Wang & Wang (seed 001): single-period rate algorithm "
+                   "(papers.md reconstruction)",
+    "rate-three": "Wang, Wang & Wang (seed 001): three-period cubic-fit algorithm, eqs. 4-17 "
+                  "as reconstructed in papers.md; sliding scheme eqs. 20-29",
+    "rk4": "Quaternion 4th-order Runge-Kutta on q' = q (x) [0, w] / 2, step 2 td (seed 001 "
+           "baseline)",
+}
+
+
+@dataclass(frozen=True)
+class CExport:
+    """Generated source and its operation counts per update."""
+
+    name: str
+    header: str
+    source: str
+    ops: dict
+    real: str
+
+
+def _lit(x, real) -> str:
+    f = float(x)
+    s = repr(f)
+    if "e" not in s and "." not in s:
+        s += ".0"
+    return s + ("f" if real == "float" else "")
+
+
+def _frac(x) -> str:
+    if isinstance(x, Fraction):
+        return f"{x.numerator}/{x.denominator}"
+    return repr(float(x))
+
+
+def _common(real: str) -> str:
+    sq, sn, cs = ("sqrtf", "sinf", "cosf") if real == "float" else ("sqrt", "sin", "cos")
+    s = _lit(SMALL_ANGLE, real)
+    one = _lit(1.0, real)
+    return f"""
+/* q_out = normalise(qp (x) q(phi)); exact exponential map, sin/x and cos series below
+   |phi|/2 < {SMALL_ANGLE} (truncation below 3e-22 relative) */
+static void sd_update(const real_t qp[4], const real_t phi[3], real_t q_out[4])
+{{
+    real_t ang = {sq}(phi[0] * phi[0] + phi[1] * phi[1] + phi[2] * phi[2]);
+    real_t half = {_lit(0.5, real)} * ang;
+    real_t s, dw, dx, dy, dz, w, x, y, z, inv;
+    if (half < {s}) {{
+        real_t x2 = half * half;
+        s = {_lit(0.5, real)} * ({one} - x2 / {_lit(6.0, real)}
+            * ({one} - x2 / {_lit(20.0, real)} * ({one} - x2 / {_lit(42.0, real)})));
+        dw = {one} - x2 / {_lit(2.0, real)} * ({one} - x2 / {_lit(12.0, real)}
+            * ({one} - x2 / {_lit(30.0, real)} * ({one} - x2 / {_lit(56.0, real)})));
+    }} else {{
+        s = {sn}(half) / ang;
+        dw = {cs}(half);
+    }}
+    dx = s * phi[0];
+    dy = s * phi[1];
+    dz = s * phi[2];
+    w = qp[0] * dw - qp[1] * dx - qp[2] * dy - qp[3] * dz;
+    x = qp[0] * dx + qp[1] * dw + qp[2] * dz - qp[3] * dy;
+    y = qp[0] * dy - qp[1] * dz + qp[2] * dw + qp[3] * dx;
+    z = qp[0] * dz + qp[1] * dy - qp[2] * dx + qp[3] * dw;
+    inv = {one} / {sq}(w * w + x * x + y * y + z * z);
+    q_out[0] = w * inv;
+    q_out[1] = x * inv;
+    q_out[2] = y * inv;
+    q_out[3] = z * inv;
+}}
+
+static void sd_cross_add(real_t phi[3], real_t c, const real_t a[3], const real_t b[3])
+{{
+    phi[0] += c * (a[1] * b[2] - a[2] * b[1]);
+    phi[1] += c * (a[2] * b[0] - a[0] * b[2]);
+    phi[2] += c * (a[0] * b[1] - a[1] * b[0]);
+}}
+"""
+
+
+#: sd_update on its sin/cos branch, counted from the generated code: |φ| (3 mul, 2 add,
+#: sqrt), half (1 mul), sin/ang (div), 3 mul, quaternion product (16 mul, 12 add),
+#: normalisation (4 mul, 3 add, sqrt, div, 4 mul). Below the small-angle threshold
+#: (|φ|/2 < 1e-2) sin and cos are replaced by their series (no libm call).
+_UPDATE_OPS = {"mul": 31, "add": 17, "div": 2, "sqrt": 2, "sin": 1, "cos": 1}
+_CROSS_OPS = {"mul": 9, "add": 6}
+
+
+def _add_ops(*parts):
+    out = {}
+    for p in parts:
+        for k, v in p.items():
+            out[k] = out.get(k, 0) + v
+    return out
+
+
+def _times(d, n):
+    return {k: v * n for k, v in d.items()}
+
+
+def _init_reset(first_q: str, counter: str) -> str:
+    """C ``init`` (store q0 in ``s->q0`` and ``s->{first_q}``, zero the counter) and ``reset``."""
+    return f"""
+void NAME_init(NAME_state *s, const real_t q0[4])
+{{
+    int i;
+    for (i = 0; i < 4; ++i) {{ s->q0[i] = q0[i]; s->{first_q}[i] = q0[i]; }}
+    s->{counter} = 0;
+}}
+
+void NAME_reset(NAME_state *s) {{ NAME_init(s, s->q0); }}
+"""
+
+
+def _rotvec_terms(k) -> list[tuple[int, int, object]]:
+    n = len(k)
+    return [(i, j, k[i][j]) for i in range(n) for j in range(i + 1, n) if k[i][j] != 0]
+
+
+def _phi_rotvec(terms, src, base_expr, n, real, comment=True):
+    lines = ["    phi[0] = 0; phi[1] = 0; phi[2] = 0;"]
+    for i in range(n):
+        lines.append(f"    phi[0] += {src}[{base_expr(i)}][0]; phi[1] += {src}[{base_expr(i)}][1]; "
+                     f"phi[2] += {src}[{base_expr(i)}][2];")
+    for i, j, c in terms:
+        cmt = f" /* {_frac(c)} */" if comment else ""
+        lines.append(f"    sd_cross_add(phi, {_lit(c, real)}{cmt}, {src}[{base_expr(i)}], "
+                     f"{src}[{base_expr(j)}]);")
+    return "\n".join(lines)
+
+
+def generate(algorithm: str, *, structure: str = "conventional", subsamples: int = 3,
+             coefficients: str | None = None, real: str = "double", h: float = 1e-4,
+             name: str | None = None) -> CExport:
+    """Generate the C for one configuration (see :func:`export_c`)."""
+    if algorithm not in ALGORITHMS:
+        raise ValueError(f"unknown algorithm {algorithm!r}; choose one of {', '.join(ALGORITHMS)}")
+    if real not in ("double", "float"):
+        raise ValueError(f"--float must be double or float, got {real!r}")
+    h = positive(h, "h (sample interval)")
+    name = name or re.sub(r"[^a-z0-9]+", "_", f"sd_{algorithm}_{structure}"
+                          + (f"_n{subsamples}" if algorithm == "rotvec" else "")).strip("_")
+    if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", name):
+        raise ValueError(f"name must be a C identifier, got {name!r}")
+    gen = {"rotvec": _gen_rotvec, "rate-single": _gen_rate, "rate-three": _gen_rate,
+           "rk4": _gen_rk4}[algorithm]
+    struct, body, ops, info = gen(algorithm, structure, subsamples, coefficients, real, h)
+    guard = name.upper() + "_H"
+    header = f"""/* {name}.h — generated by strapdown export-c. Do not edit.
+ * Algorithm: {info}
+ * Reference: {_CITE[algorithm]}
+ * Real type: {real}. Input: {"angular increments (rad)" if algorithm == "rotvec" else
+                              f"angular rates (rad/s) sampled every {h!r} s"}.
+ * Convention: Hamilton quaternions, scalar first, q_n_b (body to reference).
+ * Operations per update: {", ".join(f"{k} {v}" for k, v in ops.items())}.
+ */
+#ifndef {guard}
+#define {guard}
+
+typedef {real} real_t;
+
+typedef struct {{
+{struct}
+}} {name}_state;
+
+/* sizeof({name}_state), for callers through a foreign-function interface. */
+unsigned long {name}_state_size(void);
+/* Initialise with the attitude q0 (scalar first) at the first sample. */
+void {name}_init({name}_state *s, const real_t q0[4]);
+/* Back to the state right after init (same q0). */
+void {name}_reset({name}_state *s);
+/* Feed one sample; returns 1 and writes q_out when an attitude update completes. */
+int {name}_update({name}_state *s, const real_t sample[3], real_t q_out[4]);
+
+#endif
+"""
+    common = _common(real)
+    cross = common.index("static void sd_cross_add")
+    helpers = ("" if algorithm == "rk4" else common[:cross]) + (
+        common[cross:] if "sd_cross_add" in body else "")
+    source = f"""/* {name}.c — generated by strapdown export-c. Do not edit. See {name}.h. */
+#include <math.h>
+#include "{name}.h"
+{helpers}
+unsigned long {name}_state_size(void) {{ return (unsigned long)sizeof({name}_state); }}
+{body.replace("NAME", name)}
+"""
+    return CExport(name, header, source, ops, real)
+
+
+def _gen_rotvec(algorithm, structure, n, coefficients, real, h):
+    from strapdown.algorithms.structures import single_chain_coefficients, startup_sets
+
+    n = positive_int(n, "N (subsamples)")
+    if structure not in ("conventional", "realtime", "single-chain"):
+        raise ValueError(f"rotvec structures: conventional, realtime, single-chain; got "
+                         f"{structure!r}")
+    if structure == "single-chain":
+        if coefficients not in (None, "table3"):
+            raise ValueError("the single chain exports its designed coefficients only")
+        rows = [list(single_chain_coefficients(m + 1)) for m in range(n)]
+        width = max(n - 1, 1)
+        table = ",\n".join("    {" + ", ".join(
+            [f"{_lit(c, real)} /* {_frac(c)} */" for c in r]
+            + [_lit(0, real)] * (width - len(r))) + "}" for r in rows)
+        struct = f"    real_t q[4];\n    real_t q0[4];\n    real_t hist[{width}][3];\n    long k;"
+        body = f"""
+static const real_t SC[{n}][{width}] = {{
+{table}
+}};
+{_init_reset("q", "k")}
+
+int NAME_update(NAME_state *s, const real_t th[3], real_t q_out[4])
+{{
+    real_t phi[3];
+    int m = (int)(s->k < {n - 1} ? s->k : {n - 1});
+    int p, i;
+    phi[0] = th[0]; phi[1] = th[1]; phi[2] = th[2];
+    for (p = 1; p <= m; ++p) {{
+        const real_t *a = s->hist[(s->k - p) % {width}];
+        if (SC[m][p - 1] != 0) sd_cross_add(phi, SC[m][p - 1], a, th);
+    }}
+    sd_update(s->q, phi, q_out);
+    for (i = 0; i < 4; ++i) s->q[i] = q_out[i];
+    for (i = 0; i < 3; ++i) s->hist[s->k % {width}][i] = th[i];
+    s->k += 1;
+    return 1;
+}}
+"""
+        ops = _add_ops(_times(_CROSS_OPS, n - 1), _UPDATE_OPS)
+        return struct, body, ops, f"single-chain rotation vector, N = {n}, update every h"
+    cs = coefficient_set(coefficients or "table3", n)
+    k = cs.exact if cs.exact is not None else cs.matrix.tolist()
+    terms = _rotvec_terms(k)
+    if structure == "conventional":
+        struct = f"    real_t q[4];\n    real_t q0[4];\n    real_t th[{n}][3];\n    int count;"
+        phi = _phi_rotvec(terms, "s->th", lambda i: str(i), n, real)
+        body = f"""{_init_reset("q", "count")}
+
+int NAME_update(NAME_state *s, const real_t sample[3], real_t q_out[4])
+{{
+    real_t phi[3];
+    int i;
+    for (i = 0; i < 3; ++i) s->th[s->count][i] = sample[i];
+    s->count += 1;
+    if (s->count < {n}) return 0;
+    s->count = 0;
+{phi}
+    sd_update(s->q, phi, q_out);
+    for (i = 0; i < 4; ++i) s->q[i] = q_out[i];
+    return 1;
+}}
+"""
+        ops = _add_ops({"add": 3 * n}, _times(_CROSS_OPS, len(terms)), _UPDATE_OPS)
+        return struct, body, ops, (f"rotation vector, N = {n}, coefficients {cs.name}, "
+                                   "conventional structure (update every N h)")
+    # real-time: ring of the last N increments and N attitudes
+    sets = startup_sets(cs)
+    starts = []
+    for m, st in enumerate(sets[:-1], start=1):
+        km = st.exact if st.exact is not None else st.matrix.tolist()
+        phi_m = _phi_rotvec(_rotvec_terms(km), "s->th", lambda i: str(i), m, real)
+        starts.append(f"    if (s->k == {m}) {{\n{phi_m}\n        sd_update(s->q0, phi, q_out);"
+                      f"\n    }}")
+    main_phi = _phi_rotvec(terms, "s->th", lambda i: f"(s->k - {n} + {i}) % {n}", n, real)
+    struct = (f"    real_t qh[{n}][4];\n    real_t q0[4];\n    real_t th[{n}][3];\n    long k;")
+    body = f"""{_init_reset("qh[0]", "k")}
+
+int NAME_update(NAME_state *s, const real_t sample[3], real_t q_out[4])
+{{
+    real_t phi[3];
+    int i;
+    for (i = 0; i < 3; ++i) s->th[s->k % {n}][i] = sample[i];
+    s->k += 1;
+    if (s->k < {n}) {{
+{chr(10).join(starts) if starts else ""}
+    }} else {{
+{main_phi}
+        sd_update(s->qh[(s->k - {n}) % {n}], phi, q_out);
+    }}
+    for (i = 0; i < 4; ++i) s->qh[s->k % {n}][i] = q_out[i];
+    return 1;
+}}
+"""
+    ops = _add_ops({"add": 3 * n}, _times(_CROSS_OPS, len(terms)), _UPDATE_OPS)
+    return struct, body, ops, (f"rotation vector, N = {n}, coefficients {cs.name}, Li & Zhang "
+                               "real-time structure (update every h, N interleaved chains)")
+
+
+def _gen_rate(algorithm, structure, n, coefficients, real, h):
+    from strapdown.algorithms import rate
+
+    coeffs = coefficients or "derived"
+    single = rate.single_period_algorithm(coeffs)
+    if algorithm == "rate-single":
+        if structure != "conventional":
+            raise ValueError("rate-single has the conventional structure only")
+        alg = single
+    else:
+        if structure not in ("conventional", "sliding"):
+            raise ValueError("rate-three structures: conventional, sliding")
+        alg = rate.three_period_algorithm(coeffs)
+    w = len(alg.offsets)
+
+    def phi_code(a, idx):
+        lines = ["    phi[0] = 0; phi[1] = 0; phi[2] = 0;"]
+        for i, wt in enumerate(a.weights):
+            sw = h * float(wt)
+            lines.append(f"    phi[0] += {_lit(sw, real)} * W({idx(i)})[0]; phi[1] += "
+                         f"{_lit(sw, real)} * W({idx(i)})[1]; phi[2] += {_lit(sw, real)} * "
+                         f"W({idx(i)})[2]; /* h * {_frac(wt)} */")
+        for (i, j), c in zip(a.pairs, a.pair_coefficients, strict=True):
+            lines.append(f"    sd_cross_add(phi, {_lit(h * h * float(c), real)} /* h^2 * "
+                         f"{_frac(c)} */, W({idx(i)}), W({idx(j)}));")
+        return "\n".join(lines)
+
+    u = alg.update
+    ring = w + 1
+    struct = (f"    real_t qh[{u}][4];\n    real_t q0[4];\n    real_t win[{ring}][3];\n"
+              "    long k;")
+    macro = f"#define W(i) (s->win[((i) % {ring} + {ring}) % {ring}])"
+    sliding = structure == "sliding"
+    if algorithm == "rate-single" or not sliding:
+        body_update = f"""
+    /* sample index j = s->k - 1 just stored; an update completes every {u} samples */
+    if (s->k - 1 < {u} || (s->k - 1) % {u} != 0) return 0;
+    {{
+        long b = s->k - 1 - {u};
+{phi_code(alg, lambda i: f"b + {alg.offsets[i]}")}
+        sd_update(s->qh[0], phi, q_out);
+        for (i = 0; i < 4; ++i) s->qh[0][i] = q_out[i];
+    }}
+    return 1;"""
+        ops = _add_ops(_times({"mul": 3, "add": 3}, len(alg.weights)),
+                       _times(_CROSS_OPS, len(alg.pairs)), _UPDATE_OPS)
+    else:
+        body_update = f"""
+    {{
+        long j = s->k - 1;  /* newest sample index */
+        if (j == 0) return 0;
+        if (j < {u}) {{
+            long b = j - 1;
+{phi_code(single, lambda i: f"b + {single.offsets[i]}")}
+            sd_update(s->qh[(j - 1) % {u}], phi, q_out);
+        }} else {{
+            long b = j - {u};
+{phi_code(alg, lambda i: f"b + {alg.offsets[i]}")}
+            sd_update(s->qh[b % {u}], phi, q_out);
+        }}
+        for (i = 0; i < 4; ++i) s->qh[j % {u}][i] = q_out[i];
+    }}
+    return 1;"""
+        ops = _add_ops(_times({"mul": 3, "add": 3}, len(alg.weights)),
+                       _times(_CROSS_OPS, len(alg.pairs)), _UPDATE_OPS)
+    body = f"""
+{macro}
+{_init_reset("qh[0]", "k")}
+
+int NAME_update(NAME_state *s, const real_t sample[3], real_t q_out[4])
+{{
+    real_t phi[3];
+    int i;
+    for (i = 0; i < 3; ++i) W(s->k)[i] = sample[i];
+    s->k += 1;
+    (void)phi;
+{body_update}
+}}
+"""
+    info = (f"{algorithm}, coefficients {coeffs}, {structure} structure, td = {h!r} s")
+    return struct, body, ops, info
+
+
+def _gen_rk4(algorithm, structure, n, coefficients, real, h):
+    if structure != "conventional":
+        raise ValueError("rk4 has the conventional structure only")
+    if coefficients is not None:
+        raise ValueError("rk4 has no coefficients")
+    sq = "sqrtf" if real == "float" else "sqrt"
+    big_h = 2 * h
+    struct = "    real_t q[4];\n    real_t q0[4];\n    real_t w[3][3];\n    long k;"
+    body = f"""
+static void f(const real_t q[4], const real_t *w, real_t out[4])
+{{
+    out[0] = {_lit(0.5, real)} * (-q[1] * w[0] - q[2] * w[1] - q[3] * w[2]);
+    out[1] = {_lit(0.5, real)} * (q[0] * w[0] + q[2] * w[2] - q[3] * w[1]);
+    out[2] = {_lit(0.5, real)} * (q[0] * w[1] - q[1] * w[2] + q[3] * w[0]);
+    out[3] = {_lit(0.5, real)} * (q[0] * w[2] + q[1] * w[1] - q[2] * w[0]);
+}}
+{_init_reset("q", "k")}
+
+int NAME_update(NAME_state *s, const real_t sample[3], real_t q_out[4])
+{{
+    real_t k1[4], k2[4], k3[4], k4[4], tmp[4], n2 = 0;
+    int i;
+    const real_t H = {_lit(big_h, real)};
+    for (i = 0; i < 3; ++i) s->w[s->k % 3][i] = sample[i];
+    s->k += 1;
+    if (s->k < 3 || (s->k - 1) % 2 != 0) return 0;
+    {{
+        const real_t *w0 = s->w[(s->k - 3) % 3], *wm = s->w[(s->k - 2) % 3],
+                     *w1 = s->w[(s->k - 1) % 3];
+        f(s->q, w0, k1);
+        for (i = 0; i < 4; ++i) tmp[i] = s->q[i] + {_lit(0.5, real)} * H * k1[i];
+        f(tmp, wm, k2);
+        for (i = 0; i < 4; ++i) tmp[i] = s->q[i] + {_lit(0.5, real)} * H * k2[i];
+        f(tmp, wm, k3);
+        for (i = 0; i < 4; ++i) tmp[i] = s->q[i] + H * k3[i];
+        f(tmp, w1, k4);
+        for (i = 0; i < 4; ++i) {{
+            tmp[i] = s->q[i] + H / {_lit(6.0, real)}
+                * (k1[i] + {_lit(2.0, real)} * k2[i] + {_lit(2.0, real)} * k3[i] + k4[i]);
+            n2 += tmp[i] * tmp[i];
+        }}
+        n2 = {_lit(1.0, real)} / {sq}(n2);
+        for (i = 0; i < 4; ++i) {{ s->q[i] = tmp[i] * n2; q_out[i] = s->q[i]; }}
+    }}
+    return 1;
+}}
+"""
+    # counted from the code below: 4 × f (16 mul, 12 add), the three intermediate states
+    # (8 + 8 + 4 mul, 12 add), the final combination (4 div, 12 mul, 16 add), norm (4 mul,
+    # 4 add, sqrt, div) and scaling (4 mul)
+    ops = {"mul": 104, "add": 80, "div": 5, "sqrt": 1, "sin": 0, "cos": 0}
+    return struct, body, ops, f"quaternion RK4, step 2 td, td = {h!r} s"
+
+
+def export_c(out: str | Path, **kwargs) -> CExport:
+    """Generate and write ``<name>.h`` and ``<name>.c`` into ``out`` (atomically)."""
+    exp = generate(**kwargs)
+    out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise ValueError(f"--out {out} exists and is not a directory")
+    write_text(out / f"{exp.name}.h", exp.header)
+    write_text(out / f"{exp.name}.c", exp.source)
+    return exp
