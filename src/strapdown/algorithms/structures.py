@@ -32,7 +32,7 @@ from strapdown._core.validation import (
     positive,
     positive_int,
 )
-from strapdown.algorithms import _kernels
+from strapdown.algorithms import _kernels, tables
 from strapdown.algorithms.coning import CoefficientSet, coefficient_set
 
 __all__ = [
@@ -295,10 +295,13 @@ def _run_windowed(x, algorithm, h, starts, stride, q):
 
 
 def single_chain_coefficients(n: int) -> tuple:
-    """Exact single-chain coefficients ``c_1 … c_{N−1}`` (classical-coning optimum, designer)."""
-    from strapdown.design import derive, single_chain_structure
-
-    return derive(single_chain_structure(n)).coefficients
+    """Exact single-chain coefficients ``c_1 … c_{N−1}`` (classical-coning optimum, designer;
+    tabulated in :data:`strapdown.algorithms.tables.SINGLE_CHAIN`)."""
+    n = positive_int(n, "N (subsamples)")
+    if n not in tables.SINGLE_CHAIN:
+        raise ValueError(f"single-chain coefficients are tabulated for N = 1 … "
+                         f"{max(tables.SINGLE_CHAIN)}, got N = {n}")
+    return tables.SINGLE_CHAIN[n]
 
 
 def single_chain_table(n: int) -> np.ndarray:

@@ -299,6 +299,8 @@ def sweep(scenario, out, *, scheduler: str = "local", workers: int | None = None
         raise ValueError(f"{out} exists and is not a directory")
     store = out / "cases"
     store.mkdir(parents=True, exist_ok=True)
+    for stale in store.glob(".*.json.*"):  # temp files of a killed run (never a finished case)
+        stale.unlink(missing_ok=True)
     all_cases = cases(scn)
     pending = [c for c in all_cases if not (store / f"{c.key}.json").is_file()]
     skipped = len(all_cases) - len(pending)

@@ -1,0 +1,57 @@
+"""Designed coefficient sets the algorithms run with, tabulated as exact rationals.
+
+Every entry was derived by :func:`strapdown.design.derive` (exact rational arithmetic,
+sympy) and is re-derived by the test suite (``tests/algorithms/test_tables.py``), so the
+algorithms need no computer algebra at run time.
+
+Drift laws are for classical coning (half angle ``a``, cone rate ``Ω``, sample interval
+``h``): ``drift = −c · a² Ω (Ω h)^order`` about the cone axis, leading order in ``a``.
+"""
+
+from __future__ import annotations
+
+from fractions import Fraction as F
+
+__all__ = [
+    "RATE_SINGLE",
+    "RATE_SINGLE_DRIFT",
+    "RATE_THREE",
+    "RATE_THREE_DRIFT",
+    "RK4_DRIFT",
+    "SINGLE_CHAIN",
+]
+
+#: Single-chain coefficients c_1 … c_{N−1} (``single_chain_structure(N)``, classical-coning
+#: optimum), for N = 1 … 6.
+SINGLE_CHAIN: dict[int, tuple[F, ...]] = {
+    1: (),
+    2: (F(1, 12),),
+    3: (F(7, 60), F(-1, 60)),
+    4: (F(113, 840), F(-13, 420), F(1, 280)),
+    5: (F(367, 2520), F(-53, 1260), F(1, 120), F(-1, 1260)),
+    6: (F(4247, 27720), F(-703, 13860), F(61, 4620), F(-31, 13860), F(1, 5544)),
+}
+
+#: Single-period rate algorithm ΔΦ = td/2 (ω₀ + ω₁) + c td² ω₀ × ω₁: the cross-product
+#: coefficient c. ``derived``: ``derive(rate_structure(1))`` (quadrature error included);
+#: ``paper``: Wang, Wang & Wang's start-up form.
+RATE_SINGLE: dict[str, F] = {"derived": F(1, 6), "paper": F(1, 12)}
+RATE_SINGLE_DRIFT: dict[str, tuple[int, F]] = {"derived": (4, F(11, 1440)), "paper": (2, F(1, 12))}
+
+#: Three-period rate algorithm on ω at 0, td, 2td, 3td: pair coefficients k_ij (in units of
+#: td²) for the pairs (0,1), (0,2), (0,3), (1,2), (1,3), (2,3); the quadrature weights are
+#: Simpson's 3/8 rule, (3/8, 9/8, 9/8, 3/8) td. ``derived``: ``derive(three_period_structure())``
+#: (quadrature error included); ``paper``: the lag sums fitted to the coning term alone
+#: (``quadrature=False``), Wang, Wang & Wang's derivation as reconstructed.
+RATE_THREE_PAIRS: tuple[tuple[int, int], ...] = ((0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3))
+RATE_THREE_WEIGHTS: tuple[F, ...] = (F(3, 8), F(9, 8), F(9, 8), F(3, 8))
+RATE_THREE: dict[str, tuple[F, ...]] = {
+    "derived": (F(719, 1680), F(103, 560), F(43, 560), F(719, 1680), F(103, 560), F(719, 1680)),
+    "paper": (F(873, 2240), F(27, 112), F(87, 2240), F(873, 2240), F(27, 112), F(873, 2240)),
+}
+RATE_THREE_DRIFT: dict[str, tuple[int, F]] = {"derived": (8, F(433, 806400)),
+                                              "paper": (4, F(-1, 80))}
+
+#: Quaternion RK4 on q̇ = ½ q ⊗ ω: (order, c) per step variant, derived symbolically by
+#: :func:`strapdown.design.rk4_classical_coning_drift`.
+RK4_DRIFT: dict[str, tuple[int, F]] = {"2td": (4, F(-1, 60)), "td-interp": (2, F(1, 12))}
