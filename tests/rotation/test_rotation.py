@@ -7,8 +7,9 @@ import pytest
 from hypothesis import given
 from scipy.spatial.transform import Rotation
 
-from conftest import quat_close, rotvecs
+from conftest import quat_close
 from strapdown import rotation as R
+from strategies import rotvecs
 
 
 @given(rotvecs())
