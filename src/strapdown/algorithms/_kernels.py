@@ -434,3 +434,100 @@ def windowed_kernel(x, offsets, weights, pi, pj, pc, sa, sb, starts, stride, q_o
             phi[1] += c * (az * bx - ax * bz)
             phi[2] += c * (ax * by - ay * bx)
         _update(q_out[r], phi, q_out[r + stride])
+
+
+@njit(cache=True, inline="always")
+def _update_rows(q, src, px, py, pz, dst):
+    """q[dst] = normalise(q[src] ⊗ q(φ)), φ = (px, py, pz): :func:`_update` on scalars."""
+    ang2 = px * px + py * py + pz * pz
+    ang = np.sqrt(ang2)
+    half = 0.5 * ang
+    if half < _SMALL:
+        x2 = half * half
+        s = 0.5 * (1.0 - x2 / 6.0 * (1.0 - x2 / 20.0 * (1.0 - x2 / 42.0)))
+        dw = 1.0 - x2 / 2.0 * (1.0 - x2 / 12.0 * (1.0 - x2 / 30.0 * (1.0 - x2 / 56.0)))
+    else:
+        s = np.sin(half) / ang
+        dw = np.cos(half)
+    dx = s * px
+    dy = s * py
+    dz = s * pz
+    q0, q1, q2, q3 = q[src, 0], q[src, 1], q[src, 2], q[src, 3]
+    w = q0 * dw - q1 * dx - q2 * dy - q3 * dz
+    x = q0 * dx + q1 * dw + q2 * dz - q3 * dy
+    y = q0 * dy - q1 * dz + q2 * dw + q3 * dx
+    z = q0 * dz + q1 * dy - q2 * dx + q3 * dw
+    inv = 1.0 / np.sqrt(w * w + x * x + y * y + z * z)
+    q[dst, 0] = w * inv
+    q[dst, 1] = x * inv
+    q[dst, 2] = y * inv
+    q[dst, 3] = z * inv
+
+
+@njit(cache=True)
+def window4_kernel(x, weights, pc, sa, sb, b0, step, stride, q_out):
+    """Fused four-sample window (offsets 0 … 3, all six pairs), e.g. the three-period rate
+    algorithm, conventional (step 3, stride 1) or sliding (step 1, stride 3).
+
+    ``φ_b = sa Σ_n w_n x[b+n] + sb Σ_p c_p x[b+i_p] × x[b+j_p]`` with the pairs in the
+    order (0,1), (0,2), (0,3), (1,2), (1,3), (2,3); ``q_out[r + stride] = q_out[r] ⊗ q(φ_b)``
+    with ``b = b0 + r·step`` for every row after the given ``q_out[:stride]``. The same
+    floating-point operations in the same order as :func:`windowed_kernel` with those
+    offsets and pairs (bit-identical), the window in registers. With ``step == 1`` the
+    cross products of consecutive windows overlap: the three that involve the window's
+    first three samples are the previous window's last three, carried instead of
+    recomputed (the same products of the same operands, so the same values).
+    """
+    w0, w1, w2, w3 = sa * weights[0], sa * weights[1], sa * weights[2], sa * weights[3]
+    c01, c02, c03 = sb * pc[0], sb * pc[1], sb * pc[2]
+    c12, c13, c23 = sb * pc[3], sb * pc[4], sb * pc[5]
+    # samples 1 … 3 and cross products 12, 13, 23 "before" window b0: shifted into 0 … 2
+    # and 01, 02, 12 at the top of the loop (unused unless step == 1)
+    a1x, a1y, a1z = x[b0, 0], x[b0, 1], x[b0, 2]
+    a2x, a2y, a2z = x[b0 + 1, 0], x[b0 + 1, 1], x[b0 + 1, 2]
+    a3x, a3y, a3z = x[b0 + 2, 0], x[b0 + 2, 1], x[b0 + 2, 2]
+    e12x, e12y, e12z = a1y * a2z - a1z * a2y, a1z * a2x - a1x * a2z, a1x * a2y - a1y * a2x
+    e13x, e13y, e13z = a1y * a3z - a1z * a3y, a1z * a3x - a1x * a3z, a1x * a3y - a1y * a3x
+    e23x, e23y, e23z = a2y * a3z - a2z * a3y, a2z * a3x - a2x * a3z, a2x * a3y - a2y * a3x
+    for r in range(q_out.shape[0] - stride):
+        b = b0 + r * step
+        if step == 1:  # slide by one sample
+            a0x, a0y, a0z = a1x, a1y, a1z
+            a1x, a1y, a1z = a2x, a2y, a2z
+            a2x, a2y, a2z = a3x, a3y, a3z
+            e01x, e01y, e01z = e12x, e12y, e12z
+            e02x, e02y, e02z = e13x, e13y, e13z
+            e12x, e12y, e12z = e23x, e23y, e23z
+        else:
+            a0x, a0y, a0z = x[b, 0], x[b, 1], x[b, 2]
+            a1x, a1y, a1z = x[b + 1, 0], x[b + 1, 1], x[b + 1, 2]
+            a2x, a2y, a2z = x[b + 2, 0], x[b + 2, 1], x[b + 2, 2]
+            e01x, e01y, e01z = a0y * a1z - a0z * a1y, a0z * a1x - a0x * a1z, a0x * a1y - a0y * a1x
+            e02x, e02y, e02z = a0y * a2z - a0z * a2y, a0z * a2x - a0x * a2z, a0x * a2y - a0y * a2x
+            e12x, e12y, e12z = a1y * a2z - a1z * a2y, a1z * a2x - a1x * a2z, a1x * a2y - a1y * a2x
+        a3x, a3y, a3z = x[b + 3, 0], x[b + 3, 1], x[b + 3, 2]
+        e03x, e03y, e03z = a0y * a3z - a0z * a3y, a0z * a3x - a0x * a3z, a0x * a3y - a0y * a3x
+        e13x, e13y, e13z = a1y * a3z - a1z * a3y, a1z * a3x - a1x * a3z, a1x * a3y - a1y * a3x
+        e23x, e23y, e23z = a2y * a3z - a2z * a3y, a2z * a3x - a2x * a3z, a2x * a3y - a2y * a3x
+        px = 0.0 + w0 * a0x + w1 * a1x + w2 * a2x + w3 * a3x
+        py = 0.0 + w0 * a0y + w1 * a1y + w2 * a2y + w3 * a3y
+        pz = 0.0 + w0 * a0z + w1 * a1z + w2 * a2z + w3 * a3z
+        px += c01 * e01x
+        py += c01 * e01y
+        pz += c01 * e01z
+        px += c02 * e02x
+        py += c02 * e02y
+        pz += c02 * e02z
+        px += c03 * e03x
+        py += c03 * e03y
+        pz += c03 * e03z
+        px += c12 * e12x
+        py += c12 * e12y
+        pz += c12 * e12z
+        px += c13 * e13x
+        py += c13 * e13y
+        pz += c13 * e13z
+        px += c23 * e23x
+        py += c23 * e23y
+        pz += c23 * e23z
+        _update_rows(q_out, r, px, py, pz, r + stride)

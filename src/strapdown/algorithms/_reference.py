@@ -166,3 +166,16 @@ def quaternion_increment(theta, mode, alpha, beta, exact, q0, m: Backend):
             d = trunc(phi)
         out.append(quat_mul(out[-1], d))
     return out
+
+
+def windowed(x, offsets, weights, pairs, coefficients, sa, sb, starts, q0, stride, m: Backend):
+    """Reference twin of :func:`strapdown.algorithms._kernels.windowed_kernel` and
+    :func:`strapdown.algorithms._kernels.window4_kernel`.
+
+    ``φ_b = sa Σ_n w_n x[b+o_n] + sb Σ_p c_p x[b+o_i] × x[b+o_j]`` for ``b`` in ``starts``,
+    ``q[r + stride] = q[r] ⊗ q(φ_{starts[r]})``; ``q0`` lists the first ``stride`` attitudes.
+    """
+    sw = [sa * w for w in weights]
+    sp = [(i, j, sb * c) for (i, j), c in zip(pairs, coefficients, strict=True)]
+    phis = [windowed_rotvec([tuple(x[b + o]) for o in offsets], sw, sp, m.zero) for b in starts]
+    return chain(phis, q0, stride, m)
