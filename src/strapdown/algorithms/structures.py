@@ -264,34 +264,54 @@ def _windowed(x, algorithm, h, t0, q0, sliding, startup) -> AttitudeSolution:
         need = b0 + algorithm.span + 1
         raise ValueError(f"{algorithm.name!r} needs at least {need} samples, got {x.shape[0]}")
     u = algorithm.update
+    # output times t0 + (b0 + k·step)·h, built in place: the float arange holds the same
+    # integers exactly (< 2**53), then the same product and the same (commutative) sum
+    step = 1 if sliding else u
+    rows = (last - b0) // step + 1 + (u if sliding else 1)
+    t = np.arange(b0, b0 + rows * step, step, dtype=np.float64)
+    t *= h
+    t += t0
+    q = np.empty((rows, 4))
+    q[0] = q0
     if not sliding:
-        starts = np.arange(b0, last + 1, u)
-        q = np.empty((starts.size + 1, 4))
-        q[0] = q0
-        _run_windowed(x, algorithm, h, starts, 1, q)
-        t = t0 + (b0 + np.arange(q.shape[0]) * u) * h
-        return AttitudeSolution(t, q, "windowed", None, h, u * h, np.zeros(t.size, int))
+        _run_windowed(x, algorithm, h, b0, u, 1, q)
+        return AttitudeSolution(t, q, "windowed", None, h, u * h, np.zeros(rows, int))
     if startup is None or startup.update != 1:
         raise ValueError("the sliding scheme needs a one-sample startup algorithm")
-    starts = np.arange(b0, last + 1)
-    q = np.empty((starts.size + u, 4))
-    q[0] = q0
     if u > 1:
-        _run_windowed(x, startup, h, np.arange(b0, b0 + u - 1), 1, q[:u])
-    _run_windowed(x, algorithm, h, starts, u, q)
-    k = np.arange(q.shape[0])
-    return AttitudeSolution(t0 + (b0 + k) * h, q, "sliding", None, h, h, k % u)
+        _run_windowed(x, startup, h, b0, 1, 1, q[:u])
+    _run_windowed(x, algorithm, h, b0, 1, u, q)
+    chain = np.empty(rows, dtype=int)  # k mod u, without the temporaries of np.arange % u
+    for j in range(u):
+        chain[j::u] = j
+    return AttitudeSolution(t, q, "sliding", None, h, h, chain)
 
 
-def _run_windowed(x, algorithm, h, starts, stride, q):
-    """Fused kernel call for a WindowedAlgorithm (rates scale α by h and β by h²)."""
+def _run_windowed(x, algorithm, h, b0, step, stride, q):
+    """Fused kernel call for a WindowedAlgorithm: the update starting at sample
+    ``b0 + r·step`` writes ``q[r + stride]`` from ``q[r]``, for every row after ``q[:stride]``
+    (rates scale α by h and β by h²).
+
+    The four-sample window with all six pairs (the three-period rate algorithm) runs in
+    :func:`~strapdown.algorithms._kernels.window4_kernel` (registers, no index array, the
+    same operations); every other shape in the general ``windowed_kernel``.
+    """
+    count = q.shape[0] - stride
+    if count <= 0:
+        return
     sa, sb = (1.0, 1.0) if algorithm.input == "increment" else (h, h * h)
-    pairs = np.array(algorithm.pairs, dtype=np.int64).reshape(-1, 2)
-    _kernels.windowed_kernel(x, np.array(algorithm.offsets, dtype=np.int64),
-                             np.array([float(w) for w in algorithm.weights]),
-                             np.ascontiguousarray(pairs[:, 0]), np.ascontiguousarray(pairs[:, 1]),
-                             np.array([float(c) for c in algorithm.pair_coefficients]),
-                             sa, sb, np.asarray(starts, dtype=np.int64), stride, q)
+    weights = np.array([float(w) for w in algorithm.weights])
+    pc = np.array([float(c) for c in algorithm.pair_coefficients])
+    pairs = tuple(tuple(p) for p in algorithm.pairs)
+    if tuple(algorithm.offsets) == (0, 1, 2, 3) and pairs == ((0, 1), (0, 2), (0, 3), (1, 2),
+                                                               (1, 3), (2, 3)):
+        _kernels.window4_kernel(x, weights, pc, sa, sb, b0, step, stride, q)
+        return
+    ij = np.array(pairs, dtype=np.int64).reshape(-1, 2)
+    _kernels.windowed_kernel(x, np.array(algorithm.offsets, dtype=np.int64), weights,
+                             np.ascontiguousarray(ij[:, 0]), np.ascontiguousarray(ij[:, 1]),
+                             pc, sa, sb, np.arange(b0, b0 + count * step, step, dtype=np.int64),
+                             stride, q)
 
 
 def single_chain_coefficients(n: int) -> tuple:
