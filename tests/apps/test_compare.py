@@ -7,8 +7,9 @@ import math
 import numpy as np
 import pytest
 
+from strapdown.algorithms.spec import parse_spec
 from strapdown.analysis.evaluate import EvaluationConfig, evaluate
-from strapdown.apps.compare import compare_log, compare_motion, parse_spec
+from strapdown.apps.compare import compare_log, compare_motion
 from strapdown.cli import main
 from strapdown.truth.motions import SpinConing
 

@@ -133,7 +133,7 @@ def test_generated_code_properties(tmp_path):
 
 @pytest.mark.parametrize(("kw", "msg"), [
     ({"algorithm": "euler"}, "unknown algorithm"),
-    ({"algorithm": "rotvec", "structure": "sliding"}, "rotvec structures"),
+    ({"algorithm": "rotvec", "structure": "sliding"}, "rotvec supports the structures"),
     ({"algorithm": "rk4", "coefficients": "paper"}, "no coefficients"),
     ({"algorithm": "rotvec", "real": "half"}, "double or float"),
     ({"algorithm": "rotvec", "name": "9bad"}, "C identifier"),

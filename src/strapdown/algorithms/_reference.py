@@ -78,7 +78,8 @@ def realtime(theta, ks, q0, m: Backend):
 
 
 def chain(phi, q0, stride, m: Backend):
-    """Reference twin of :func:`strapdown.algorithms._kernels.chain_kernel` (q0: list of ``stride`` quats)."""
+    """Reference twin of :func:`strapdown.algorithms._kernels.chain_kernel` (q0: list of
+    ``stride`` quats)."""
     out = [tuple(q) for q in q0]
     for k, p in enumerate(phi):
         out.append(update(out[k], p, m))
@@ -103,7 +104,8 @@ def windowed_rotvec(samples, weights, pairs, zero):
 
 
 def rk4(omega, h, q0, mode, m: Backend):
-    """Reference twin of :func:`strapdown.algorithms._kernels.rk4_kernel` (mode 0: step 2h; 1: step h)."""
+    """Reference twin of :func:`strapdown.algorithms._kernels.rk4_kernel` (mode 0: step 2h;
+    1: step h)."""
     stride = 2 if mode == 0 else 1
     big_h = stride * h
     half = big_h / 2

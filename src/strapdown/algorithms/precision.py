@@ -251,7 +251,8 @@ def run_mp(
 
 def run_rk4_mp(motion: Motion, *, h: float, samples: int, step: str = "2td", digits: int = 50,
                t0: float = 0.0) -> MpSolution:
-    """Quaternion RK4 on exact rate samples in arbitrary precision (see :mod:`strapdown.algorithms.rate`)."""
+    """Quaternion RK4 on exact rate samples in arbitrary precision (see
+    :mod:`strapdown.algorithms.rate`)."""
     if step not in ("2td", "td-interp"):
         raise ValueError(f"step must be '2td' or 'td-interp', got {step!r}")
     h, samples, digits = _check_run(motion, h, samples, digits)

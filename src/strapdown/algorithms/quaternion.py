@@ -24,9 +24,11 @@ import numpy as np
 
 from strapdown._core.validation import as_quaternions, as_vectors, finite_array, positive
 from strapdown.algorithms import _kernels
+from strapdown.algorithms.family import Family
 from strapdown.algorithms.structures import AttitudeSolution
 
-__all__ = ["ALGORITHMS", "STATED", "QuaternionAlgorithm", "quaternion_attitude", "subintervals"]
+__all__ = ["ALGORITHMS", "FAMILIES", "STATED", "QuaternionAlgorithm", "quaternion_attitude",
+           "subintervals"]
 
 ALGORITHMS = ("miller", "panov", "power")
 #: Coefficients as the paper states them (α, β).
@@ -99,3 +101,64 @@ def quaternion_attitude(increments, algorithm: QuaternionAlgorithm, *, step: flo
                                          bool(algorithm.exact_exp), q0, q)
     t = float(t0) + np.arange(m + 1) * step
     return AttitudeSolution(t, q, algorithm.name, None, step / sub, step, np.zeros(m + 1, int))
+
+
+class _QuaternionFamily(Family):
+    """Plaksiy's A1–A3: increments over sub-intervals of the computation step ΔT."""
+
+    input_kind = "increment"
+    stepped = True
+    options = frozenset({"alpha", "beta", "step", "exact_exp"})
+    reference = ("Plaksiy (2024): quaternion algorithms A1 (Miller), A2 (Panov), A3 (power) "
+                 "on the spherical (Krylov-angle) model")
+
+    def check(self, spec) -> None:
+        if spec.coefficients is not None:
+            raise ValueError(f"{self.name} takes --alpha/--beta, not --coefficients")
+        if spec.beta is not None and self.name != "miller":
+            raise ValueError(f"{self.name} has one coefficient (--alpha)")
+        self._step(spec)
+        super().check(spec)
+
+    def configured(self, spec) -> QuaternionAlgorithm:
+        """The algorithm with the spec's coefficients (the paper's stated ones by default)."""
+        a0, b0 = STATED[self.name]
+        return QuaternionAlgorithm(self.name, a0 if spec.alpha is None else spec.alpha,
+                                   b0 if spec.beta is None else spec.beta, spec.exact_exp)
+
+    def _step(self, spec) -> float:
+        if spec.step is None:
+            raise ValueError(f"{self.name} needs --step (the computation step ΔT, s)")
+        return spec.step
+
+    def min_samples(self, spec) -> int:
+        return subintervals(self.name)
+
+    def update_period(self, spec, h: float) -> float:
+        return self._step(spec)
+
+    def run(self, spec, data, *, h, t=None, t0=0.0, q0=None) -> AttitudeSolution:
+        return quaternion_attitude(data, self.configured(spec), step=self._step(spec), t0=t0,
+                                   q0=q0)
+
+
+class Miller(_QuaternionFamily):
+    """A1: Miller's three-sample quaternion algorithm (α, β)."""
+
+    name = "miller"
+
+
+class Panov(_QuaternionFamily):
+    """A2: Panov's two-sample algorithm (α)."""
+
+    name = "panov"
+
+
+class Power(_QuaternionFamily):
+    """A3: the power (series) algorithm (α)."""
+
+    name = "power"
+
+
+#: The families this module defines, in registry order.
+FAMILIES: tuple[Family, ...] = (Miller(), Panov(), Power())

@@ -34,34 +34,31 @@ from fractions import Fraction
 import numpy as np
 
 from strapdown._core.validation import as_quaternions, finite_array, first_bad_step
-from strapdown.algorithms import _kernels
+from strapdown.algorithms import _kernels, tables
 from strapdown.algorithms.coning import WindowedAlgorithm
+from strapdown.algorithms.family import DriftLaw, Family
 from strapdown.algorithms.structures import AttitudeSolution, _windowed
 
 __all__ = [
     "ALGORITHMS",
     "COEFFICIENTS",
+    "FAMILIES",
     "RK4_DRIFT",
     "RK4_STEPS",
     "UNIFORM_TOLERANCE",
     "RateRecord",
     "check_rate_record",
-    "predicted_drift_law",
     "rate_attitude",
     "single_period_algorithm",
     "three_period_algorithm",
-    "update_period",
 ]
 
 F = Fraction
-ALGORITHMS = ("rate-single", "rate-three", "rk4")
-STRUCTURES = {"rate-single": ("conventional",), "rate-three": ("conventional", "sliding"),
-              "rk4": ("conventional",)}
 COEFFICIENTS = ("derived", "paper")
 RK4_STEPS = ("2td", "td-interp")
 #: Classical-coning drift (order, c) of RK4, drift = −c·a²Ω(Ωtd)^order; derived symbolically
 #: by :func:`strapdown.design.rk4_classical_coning_drift` (re-derived in the test suite).
-RK4_DRIFT = {"2td": (4, F(-1, 60)), "td-interp": (2, F(1, 12))}
+RK4_DRIFT = tables.RK4_DRIFT
 #: Relative spread of sample intervals tolerated as "uniform".
 UNIFORM_TOLERANCE = 1e-6
 
@@ -125,56 +122,21 @@ def single_period_algorithm(coefficients: str = "derived") -> WindowedAlgorithm:
 
 
 def _single_coefficient(coefficients: str) -> Fraction:
-    if coefficients == "paper":
-        return F(1, 12)
-    if coefficients == "derived":
-        from strapdown.design import derive, rate_structure
-
-        return derive(rate_structure(1)).coefficients[0]
-    raise ValueError(f"rate coefficients must be one of {', '.join(COEFFICIENTS)}, "
-                     f"got {coefficients!r}")
+    if coefficients not in tables.RATE_SINGLE:
+        raise ValueError(f"rate coefficients must be one of {', '.join(COEFFICIENTS)}, "
+                         f"got {coefficients!r}")
+    return tables.RATE_SINGLE[coefficients]
 
 
 def three_period_algorithm(coefficients: str = "derived") -> WindowedAlgorithm:
-    """The three-period rate algorithm (update every 3 td)."""
-    from strapdown.design import derive, three_period_structure
-
-    if coefficients not in COEFFICIENTS:
+    """The three-period rate algorithm (update every 3 td), coefficients from
+    :data:`strapdown.algorithms.tables.RATE_THREE`."""
+    if coefficients not in tables.RATE_THREE:
         raise ValueError(f"rate coefficients must be one of {', '.join(COEFFICIENTS)}, "
                          f"got {coefficients!r}")
-    d = derive(three_period_structure(), quadrature=coefficients == "derived")
-    alg = d.algorithm()
-    return WindowedAlgorithm(alg.input, alg.update, alg.offsets, alg.weights, alg.pairs,
-                             alg.pair_coefficients, f"rate-three ({coefficients})")
-
-
-def update_period(algorithm: str, td: float, *, structure: str = "conventional",
-                  rk4_step: str = "2td") -> float:
-    """Time between attitude outputs of a rate algorithm sampled every ``td``."""
-    if algorithm == "rate-single":
-        return td
-    if algorithm == "rate-three":
-        return td if structure == "sliding" else 3 * td
-    if algorithm == "rk4":
-        _check_step(rk4_step)
-        return 2 * td if rk4_step == "2td" else td
-    raise ValueError(f"unknown rate algorithm {algorithm!r}; choose one of {', '.join(ALGORITHMS)}")
-
-
-def predicted_drift_law(algorithm: str, *, coefficients: str = "derived",
-                        rk4_step: str = "2td") -> tuple[int, Fraction]:
-    """Classical-coning drift law ``(order, c)``: drift = −c·a²Ω(Ωtd)^order (the true one)."""
-    from strapdown.design import classical_coning_drift, rate_structure, three_period_structure
-
-    if algorithm == "rk4":
-        _check_step(rk4_step)
-        return RK4_DRIFT[rk4_step]
-    if algorithm == "rate-single":
-        return classical_coning_drift(rate_structure(1), [_single_coefficient(coefficients)])
-    if algorithm == "rate-three":
-        alg = three_period_algorithm(coefficients)
-        return classical_coning_drift(three_period_structure(), alg.pair_coefficients)
-    raise ValueError(f"unknown rate algorithm {algorithm!r}; choose one of {', '.join(ALGORITHMS)}")
+    return WindowedAlgorithm("rate", 3, (0, 1, 2, 3), tables.RATE_THREE_WEIGHTS,
+                             tables.RATE_THREE_PAIRS, tables.RATE_THREE[coefficients],
+                             f"rate-three ({coefficients})")
 
 
 def _check_step(step):
@@ -186,6 +148,9 @@ def rate_attitude(t, omega, *, algorithm: str, structure: str = "conventional",
                   coefficients: str = "derived", rk4_step: str = "2td",
                   q0=None) -> AttitudeSolution:
     """Attitude from uniformly sampled rates.
+
+    A convenience over :class:`~strapdown.algorithms.spec.AlgorithmSpec` for the rate
+    families.
 
     Parameters
     ----------
@@ -207,31 +172,160 @@ def rate_attitude(t, omega, *, algorithm: str, structure: str = "conventional",
     AttitudeSolution
         Outputs start at ``t[0]``; ``chain`` marks the sliding scheme's three chains.
     """
+    from strapdown.algorithms.spec import AlgorithmSpec
+
     if algorithm not in ALGORITHMS:
         raise ValueError(f"unknown rate algorithm {algorithm!r}; choose one of "
                          f"{', '.join(ALGORITHMS)}")
-    if structure not in STRUCTURES[algorithm]:
-        raise ValueError(f"{algorithm} supports the structures {', '.join(STRUCTURES[algorithm])}"
-                         f", not {structure!r}")
-    need = {"rate-single": 2, "rate-three": 4, "rk4": 3 if rk4_step == "2td" else 2}[algorithm]
-    rec = check_rate_record(t, omega, min_samples=need)
-    q0 = _q0(q0)
-    if algorithm == "rk4":
-        _check_step(rk4_step)
-        mode = 0 if rk4_step == "2td" else 1
+    spec = AlgorithmSpec(algorithm, structure=structure, rk4_step=rk4_step,
+                         coefficients=None if algorithm == "rk4" else coefficients)
+    return spec.run_rates(t, omega, q0=q0)
+
+
+class _RateFamily(Family):
+    """Shared by the windowed rate families: validated record in, attitude out."""
+
+    input_kind = "rate"
+    default_coefficients = "derived"
+    reference = ""
+
+    def coefficient_names(self) -> tuple[str, ...]:
+        return COEFFICIENTS
+
+    def windowed(self, spec) -> WindowedAlgorithm:
+        """The configured windowed algorithm (what the C exporter and the filter need)."""
+        raise NotImplementedError
+
+    def run(self, spec, data, *, h, t=None, t0=0.0, q0=None) -> AttitudeSolution:
+        rec = check_rate_record(t, data, min_samples=self.min_samples(spec))
+        w = np.ascontiguousarray(rec.omega)  # validated once, by check_rate_record
+        sliding = spec.structure == "sliding"
+        startup = single_period_algorithm(spec.resolved_coefficients) if sliding else None
+        return _windowed(w, self.windowed(spec), rec.td, float(rec.t[0]), _q0(q0), sliding,
+                         startup)
+
+    def propagation(self, spec) -> dict:
+        w = self.windowed(spec)
+        sliding = spec.structure == "sliding"
+        # the sliding scheme starts with single-period steps of the same coefficient set
+        start_c = (float(single_period_algorithm(spec.resolved_coefficients)
+                         .pair_coefficients[0]) if sliding else 0.0)
+        return dict(is_rate=True, offsets=np.array(w.offsets, np.int64),
+                    weights=np.array([float(x) for x in w.weights]),
+                    pi=np.array([p[0] for p in w.pairs], np.int64),
+                    pj=np.array([p[1] for p in w.pairs], np.int64),
+                    pc=np.array([float(c) for c in w.pair_coefficients]),
+                    stride=1 if sliding else w.update, span=w.span, end_off=w.span,
+                    lag=w.span if sliding else 1, start_c=start_c, rk4=False)
+
+
+class RateSingle(_RateFamily):
+    """``rate-single``: ΔΦ = td/2 (ω₀ + ω₁) + c td² ω₀ × ω₁, an update every td."""
+
+    name = "rate-single"
+    reference = ("Wang, Wang & Wang: single-period rate algorithm (start-up form; c = 1/12 "
+                 "as printed, c = 1/6 derived)")
+
+    def windowed(self, spec) -> WindowedAlgorithm:
+        return single_period_algorithm(spec.resolved_coefficients)
+
+    def min_samples(self, spec) -> int:
+        return 2
+
+    def update_period(self, spec, h: float) -> float:
+        return h
+
+    def drift_law(self, spec) -> DriftLaw:
+        return DriftLaw(*tables.RATE_SINGLE_DRIFT[spec.resolved_coefficients])
+
+    def run_mp(self, spec, motion, *, h, samples, digits):
+        from strapdown.algorithms.precision import run_windowed_mp
+
+        return run_windowed_mp(motion, self.windowed(spec), h=h, updates=samples - 1,
+                               digits=digits)
+
+
+class RateThree(_RateFamily):
+    """``rate-three``: the three-period cubic-fit algorithm, conventional or sliding."""
+
+    name = "rate-three"
+    structures = ("conventional", "sliding")
+    reference = ("Wang, Wang & Wang: three-period cubic-fit algorithm, eqs. 4-17 as "
+                 "reconstructed; sliding scheme eqs. 20-29")
+
+    def windowed(self, spec) -> WindowedAlgorithm:
+        return three_period_algorithm(spec.resolved_coefficients)
+
+    def min_samples(self, spec) -> int:
+        return 4
+
+    def update_period(self, spec, h: float) -> float:
+        return h if spec.structure == "sliding" else 3 * h
+
+    def drift_law(self, spec) -> DriftLaw:
+        return DriftLaw(*tables.RATE_THREE_DRIFT[spec.resolved_coefficients])
+
+    def run_mp(self, spec, motion, *, h, samples, digits):
+        from strapdown.algorithms.precision import run_windowed_mp
+
+        c = spec.resolved_coefficients
+        if spec.structure == "sliding":
+            return run_windowed_mp(motion, self.windowed(spec), h=h, updates=samples - 3,
+                                   digits=digits, sliding=True,
+                                   startup=single_period_algorithm(c))
+        return run_windowed_mp(motion, self.windowed(spec), h=h, updates=(samples - 1) // 3,
+                               digits=digits)
+
+
+class Rk4(Family):
+    """``rk4``: quaternion fourth-order Runge–Kutta on q̇ = ½ q ⊗ ω, normalised each step."""
+
+    name = "rk4"
+    input_kind = "rate"
+    options = frozenset({"rk4_step"})
+    reference = ("Quaternion 4th-order Runge-Kutta on q' = q (x) [0, w] / 2, step 2 td "
+                 "(Wang, Wang & Wang's baseline)")
+
+    def check(self, spec) -> None:
+        super().check(spec)
+        _check_step(spec.rk4_step)
+
+    def min_samples(self, spec) -> int:
+        return 3 if spec.rk4_step == "2td" else 2
+
+    def update_period(self, spec, h: float) -> float:
+        return 2 * h if spec.rk4_step == "2td" else h
+
+    def drift_law(self, spec) -> DriftLaw:
+        return DriftLaw(*RK4_DRIFT[spec.rk4_step])
+
+    def run(self, spec, data, *, h, t=None, t0=0.0, q0=None) -> AttitudeSolution:
+        rec = check_rate_record(t, data, min_samples=self.min_samples(spec))
+        mode = 0 if spec.rk4_step == "2td" else 1
         stride = 2 if mode == 0 else 1
         m = (rec.t.size - 1) // stride
         q = np.empty((m + 1, 4))
-        _kernels.rk4_kernel(np.ascontiguousarray(rec.omega), rec.td, q0, mode, q)
+        _kernels.rk4_kernel(np.ascontiguousarray(rec.omega), rec.td, _q0(q0), mode, q)
         tt = rec.t[0] + np.arange(m + 1) * stride * rec.td
         return AttitudeSolution(tt, q, "rk4", None, rec.td, stride * rec.td,
                                 np.zeros(m + 1, int))
-    w = np.ascontiguousarray(rec.omega)  # validated once, by check_rate_record
-    if algorithm == "rate-single":
-        return _windowed(w, single_period_algorithm(coefficients), rec.td, float(rec.t[0]), q0,
-                         False, None)
-    return _windowed(w, three_period_algorithm(coefficients), rec.td, float(rec.t[0]), q0,
-                     structure == "sliding", single_period_algorithm(coefficients))
+
+    def run_mp(self, spec, motion, *, h, samples, digits):
+        from strapdown.algorithms.precision import run_rk4_mp
+
+        return run_rk4_mp(motion, h=h, samples=samples, step=spec.rk4_step, digits=digits)
+
+    def propagation(self, spec) -> dict:
+        if spec.rk4_step != "2td" or spec.structure != "conventional":
+            raise ValueError("the filter's rk4 is the 2td step, conventional structure")
+        i0, f0 = np.zeros(0, np.int64), np.zeros(0)
+        return dict(is_rate=True, offsets=i0, weights=f0, pi=i0, pj=i0, pc=f0, stride=2,
+                    span=2, end_off=2, lag=1, start_c=0.0, rk4=True)
+
+
+#: The families this module defines, in registry order.
+FAMILIES: tuple[Family, ...] = (RateSingle(), RateThree(), Rk4())
+ALGORITHMS = tuple(f.name for f in FAMILIES)
 
 
 def _q0(q0):

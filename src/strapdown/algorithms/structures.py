@@ -94,7 +94,8 @@ class AttitudeSolution:
 def _check_inputs(increments, coefficients, h, q0, t0):
     if not isinstance(coefficients, CoefficientSet):
         raise ValueError(
-            "coefficients must be a CoefficientSet (see strapdown.algorithms.coning.coefficient_set), "
+            "coefficients must be a CoefficientSet (see "
+            "strapdown.algorithms.coning.coefficient_set), "
             f"got {type(coefficients).__name__}"
         )
     theta, h, t0, q0 = _stream_inputs(increments, "increments", h, t0, q0)

@@ -15,18 +15,17 @@ import numpy as np
 
 from strapdown import analysis
 from strapdown._core.validation import positive, positive_int
-from strapdown.algorithms.coning import MAX_SUBSAMPLES, CoefficientSet, coefficient_set
-from strapdown.algorithms.precision import run_mp, run_rk4_mp, run_windowed_mp
-from strapdown.algorithms.structures import STRUCTURES, run_structure
+from strapdown.algorithms.coning import CoefficientSet
+from strapdown.algorithms.precision import run_mp
+from strapdown.algorithms.spec import AlgorithmSpec, algorithms_taking
+from strapdown.algorithms.structures import run_structure
 from strapdown.truth import sensors
 from strapdown.truth.motions import ClassicalConing, KrylovMotion, Motion, PureSpin, SpinConing
 
 __all__ = ["MOTIONS", "Evaluation", "EvaluationConfig", "build_motion", "evaluate"]
 
 MOTIONS = ("coning", "spin", "spin-coning", "krylov")
-ALGORITHMS = ("rotvec", "rate-single", "rate-three", "rk4", "miller", "panov", "power")
-RATE_ALGORITHMS = ("rate-single", "rate-three", "rk4")
-QUATERNION_ALGORITHMS = ("miller", "panov", "power")
+RATE_ALGORITHMS = algorithms_taking("rate")
 
 
 @dataclass(frozen=True)
@@ -62,53 +61,29 @@ class EvaluationConfig:
     gyro: sensors.GyroErrors | None = field(default=None)
     seed: int | None = None
 
+    @property
+    def spec(self) -> AlgorithmSpec:
+        """The configured algorithm (validated)."""
+        return AlgorithmSpec(self.algorithm, subsamples=self.subsamples,
+                             coefficients=self.coefficients, structure=self.structure,
+                             rk4_step=self.rk4_step, alpha=self.alpha, beta=self.beta,
+                             step=self.step, exact_exp=self.exact_exp)
+
     def validate(self) -> None:
         if self.motion not in MOTIONS:
             raise ValueError(f"unknown motion {self.motion!r}; choose one of {', '.join(MOTIONS)}")
-        if self.algorithm not in ALGORITHMS:
-            raise ValueError(
-                f"unknown algorithm {self.algorithm!r}; choose one of {', '.join(ALGORITHMS)}"
-            )
-        if self.algorithm in QUATERNION_ALGORITHMS:
-            if self.step is None:
-                raise ValueError(f"{self.algorithm} needs --step (the computation step ΔT, s)")
-            positive(self.step, "step")
-            if self.precision is not None:
+        spec = self.spec
+        if self.precision is not None:
+            if spec.family.stepped:  # the quaternion algorithms: float64 only
                 raise ValueError(f"{self.algorithm} runs in float64 only; drop --precision")
-            if self.coefficients is not None:
-                raise ValueError(f"{self.algorithm} takes --alpha/--beta, not --coefficients")
-            if self.beta is not None and self.algorithm != "miller":
-                raise ValueError(f"{self.algorithm} has one coefficient (--alpha)")
-        elif self.alpha is not None or self.beta is not None or self.exact_exp:
-            raise ValueError("--alpha, --beta and --exact-exp belong to miller, panov and power")
-        if self.algorithm in RATE_ALGORITHMS:
-            from strapdown.algorithms import rate
-
-            if self.structure not in rate.STRUCTURES[self.algorithm]:
-                raise ValueError(
-                    f"{self.algorithm} supports the structures "
-                    f"{', '.join(rate.STRUCTURES[self.algorithm])}, not {self.structure!r}"
-                )
-            if self.algorithm == "rk4":
-                if self.coefficients is not None:
-                    raise ValueError("rk4 has no coefficients; drop --coefficients")
-                if self.rk4_step not in rate.RK4_STEPS:
-                    raise ValueError(f"rk4 step must be one of {', '.join(rate.RK4_STEPS)}")
-            elif self.coefficients not in (None, *rate.COEFFICIENTS):
-                raise ValueError(f"{self.algorithm} takes coefficients "
-                                 f"{' or '.join(rate.COEFFICIENTS)}, not {self.coefficients!r}")
-        elif self.algorithm in QUATERNION_ALGORITHMS:
-            if self.structure != "conventional":
-                raise ValueError(f"{self.algorithm} has the conventional structure only")
-        elif self.structure not in STRUCTURES:
-            raise ValueError(
-                f"unknown structure {self.structure!r}; choose one of {', '.join(STRUCTURES)}"
-            )
+            positive_int(self.precision, "precision (digits)")
+            if self.gyro is not None and not self.gyro.is_ideal:
+                raise ValueError("arbitrary precision runs take ideal increments only")
         positive(self.sample_rate_hz, "sample rate (Hz)")
         positive(self.duration, "duration (s)")
-        n = positive_int(self.subsamples, "subsamples N")
-        if n > MAX_SUBSAMPLES:
-            raise ValueError(f"subsamples N must be at most {MAX_SUBSAMPLES}, got {n}")
+        self._validate_motion()
+
+    def _validate_motion(self) -> None:
         if self.motion == "krylov":
             if len(self.krylov_rates) != 3 or not all(map(math.isfinite, self.krylov_rates)):
                 raise ValueError(f"--krylov-rates needs three finite numbers, got "
@@ -120,10 +95,6 @@ class EvaluationConfig:
                 raise ValueError(f"half angle must be finite, got {self.half_angle_deg}")
         if not math.isfinite(self.spin_rate_dps):
             raise ValueError(f"spin rate must be finite, got {self.spin_rate_dps}")
-        if self.precision is not None:
-            positive_int(self.precision, "precision (digits)")
-            if self.gyro is not None and not self.gyro.is_ideal:
-                raise ValueError("arbitrary precision runs take ideal increments only")
 
     @property
     def h(self) -> float:
@@ -131,23 +102,22 @@ class EvaluationConfig:
 
     @property
     def resolved_coefficients(self) -> str | None:
-        if self.coefficients is not None or self.algorithm in ("rk4", *QUATERNION_ALGORITHMS):
-            return self.coefficients
-        return "table3" if self.algorithm == "rotvec" else "derived"
+        return self.spec.resolved_coefficients
 
     @property
     def samples(self) -> int:
-        if self.algorithm in QUATERNION_ALGORITHMS:
+        spec = self.spec
+        if spec.family.stepped:  # whole computation steps of sub-interval increments
             steps = round(self.duration / self.step)
             if steps < 1:
                 raise ValueError(f"duration {self.duration} s is shorter than one step")
-            return steps * (3 if self.algorithm == "miller" else 2)
-        if self.algorithm in RATE_ALGORITHMS:
+            return steps * spec.min_samples
+        if spec.input_kind == "rate":
             n = round(self.duration * self.sample_rate_hz) + 1
-            need = 4 if self.algorithm == "rate-three" else 3 if self.algorithm == "rk4" else 2
-            if n < need:
+            if n < spec.min_samples:
                 raise ValueError(f"duration {self.duration} s at {self.sample_rate_hz} Hz gives "
-                                 f"{n} rate samples; {self.algorithm} needs at least {need}")
+                                 f"{n} rate samples; {self.algorithm} needs at least "
+                                 f"{spec.min_samples}")
             return n
         n = round(self.duration * self.sample_rate_hz)
         if self.structure == "conventional":
@@ -229,7 +199,7 @@ class Evaluation:
 
     def _quaternion_coefficients(self) -> dict:
         c = self.config
-        if c.algorithm not in QUATERNION_ALGORITHMS:
+        if not c.spec.family.stepped:
             return {}
         from strapdown.algorithms.quaternion import STATED
 
@@ -246,15 +216,41 @@ def evaluate(cfg: EvaluationConfig, *, coefficients: CoefficientSet | None = Non
     ----------
     cfg : EvaluationConfig
     coefficients : CoefficientSet, optional
-        Overrides ``cfg.coefficients`` (e.g. a user matrix).
+        Overrides ``cfg.coefficients`` of a ``rotvec`` configuration (e.g. a user matrix).
     """
     cfg.validate()
     motion = build_motion(cfg)
-    if cfg.algorithm in RATE_ALGORITHMS:
-        return _evaluate_rate(cfg, motion)
-    if cfg.algorithm in QUATERNION_ALGORITHMS:
+    spec = cfg.spec
+    if coefficients is not None:
+        return _evaluate_user_set(cfg, motion, coefficients)
+    if spec.family.stepped:
         return _evaluate_quaternion(cfg, motion)
-    cs = coefficients or coefficient_set(cfg.resolved_coefficients, cfg.subsamples)
+    h, n = cfg.h, cfg.samples
+    if cfg.precision is not None:
+        s = spec.run_mp(motion, h=h, samples=n, digits=cfg.precision)
+        t, err, ang, chain, start = s.t, s.err, s.angle, s.chain, s.startup
+    else:
+        sol = spec.run(_gyro(cfg, motion, spec.input_kind, h, n), q0=motion.attitude(0.0))
+        err, ang = analysis.attitude_errors(sol.t, sol.q, motion)
+        t, chain, start = sol.t, sol.chain, sol.startup
+    law = spec.drift_law()
+    predicted = None
+    if cfg.motion == "coning" and law is not None:
+        predicted = law.predict(motion.half_angle, motion.cone_rate, h)
+    return _finish(cfg, motion, t, err, ang, chain, start, predicted, spec.update_period(h), n)
+
+
+def _gyro(cfg: EvaluationConfig, motion: Motion, kind: str, h: float, n: int):
+    if kind == "rate":
+        return sensors.rate_samples(motion, h, n, errors=cfg.gyro, rng=cfg.seed)
+    return sensors.increments(motion, h, n, errors=cfg.gyro, rng=cfg.seed)
+
+
+def _evaluate_user_set(cfg: EvaluationConfig, motion: Motion, cs: CoefficientSet) -> Evaluation:
+    """A rotation-vector configuration with a user's coefficient set."""
+    if cfg.algorithm != "rotvec":
+        raise ValueError(f"a coefficient set overrides rotvec configurations, not "
+                         f"{cfg.algorithm}")
     if cs.n != cfg.subsamples:
         raise ValueError(f"coefficient set has N = {cs.n}, configuration says {cfg.subsamples}")
     h, n = cfg.h, cfg.samples
@@ -270,58 +266,16 @@ def evaluate(cfg: EvaluationConfig, *, coefficients: CoefficientSet | None = Non
     if cfg.motion == "coning" and cs.classical_optimum:
         predicted = analysis.table1_prediction(motion.half_angle, motion.cone_rate, h, cs.n)
     return _finish(cfg, motion, t, err, ang, chain, start, predicted,
-                   analysis.update_period(cfg.structure, cs.n, h), n)
-
-
-def _evaluate_rate(cfg: EvaluationConfig, motion: Motion) -> Evaluation:
-    from strapdown.algorithms import rate
-
-    h, n = cfg.h, cfg.samples
-    coeffs = cfg.resolved_coefficients
-    alg = cfg.algorithm
-    sliding = cfg.structure == "sliding"
-    if cfg.precision is not None:
-        if alg == "rk4":
-            s = run_rk4_mp(motion, h=h, samples=n, step=cfg.rk4_step, digits=cfg.precision)
-        elif alg == "rate-single":
-            s = run_windowed_mp(motion, rate.single_period_algorithm(coeffs), h=h, updates=n - 1,
-                                digits=cfg.precision)
-        elif sliding:
-            s = run_windowed_mp(motion, rate.three_period_algorithm(coeffs), h=h, updates=n - 3,
-                                digits=cfg.precision, sliding=True,
-                                startup=rate.single_period_algorithm(coeffs))
-        else:
-            s = run_windowed_mp(motion, rate.three_period_algorithm(coeffs), h=h,
-                                updates=(n - 1) // 3, digits=cfg.precision)
-        t, err, ang, chain = s.t, s.err, s.angle, s.chain
-    else:
-        rec = sensors.rate_samples(motion, h, n, errors=cfg.gyro, rng=cfg.seed)
-        sol = rate.rate_attitude(rec.t, rec.data, algorithm=alg, structure=cfg.structure,
-                                 coefficients=coeffs or "derived", rk4_step=cfg.rk4_step,
-                                 q0=motion.attitude(0.0))
-        err, ang = analysis.attitude_errors(sol.t, sol.q, motion)
-        t, chain = sol.t, sol.chain
-    predicted = None
-    if cfg.motion == "coning":
-        order, c = rate.predicted_drift_law(alg, coefficients=coeffs or "derived",
-                                            rk4_step=cfg.rk4_step)
-        if order is not None:
-            predicted = (-float(c) * motion.half_angle**2 * motion.cone_rate
-                         * (motion.cone_rate * h) ** order)
-    period = rate.update_period(alg, h, structure=cfg.structure, rk4_step=cfg.rk4_step)
-    return _finish(cfg, motion, t, err, ang, chain, 0, predicted, period, n)
+                   cfg.spec.update_period(h), n)
 
 
 def _evaluate_quaternion(cfg: EvaluationConfig, motion: Motion) -> Evaluation:
-    from strapdown.algorithms.quaternion import STATED, QuaternionAlgorithm, quaternion_attitude
-
-    a0, b0 = STATED[cfg.algorithm]
-    alg = QuaternionAlgorithm(cfg.algorithm, a0 if cfg.alpha is None else cfg.alpha,
-                              b0 if cfg.beta is None else cfg.beta, cfg.exact_exp)
+    spec = cfg.spec
     n = cfg.samples
-    sub = 3 if cfg.algorithm == "miller" else 2
-    rec = sensors.increments(motion, cfg.step / sub, n, errors=cfg.gyro, rng=cfg.seed)
-    sol = quaternion_attitude(rec.data, alg, step=cfg.step, q0=motion.attitude(0.0))
+    rec = sensors.increments(motion, cfg.step / spec.min_samples, n, errors=cfg.gyro,
+                             rng=cfg.seed)
+    sol = spec.run_increments(rec.data, h=cfg.step / spec.min_samples,
+                              q0=motion.attitude(0.0))
     err, ang = analysis.attitude_errors(sol.t, sol.q, motion)
     acc = analysis.accumulated_drift(sol.q, motion.attitude(sol.t))
     ev = _finish(cfg, motion, sol.t, err, ang, sol.chain, 0, None, cfg.step, n)

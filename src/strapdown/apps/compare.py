@@ -24,51 +24,11 @@ from pathlib import Path
 
 import numpy as np
 
-from strapdown.analysis.evaluate import ALGORITHMS, RATE_ALGORITHMS, EvaluationConfig, evaluate
+from strapdown.algorithms.spec import AlgorithmSpec, parse_spec
+from strapdown.analysis.evaluate import EvaluationConfig, evaluate
 from strapdown.io.report import begin_report
 
-__all__ = ["AlgorithmRun", "compare_log", "compare_motion", "parse_spec"]
-
-#: EvaluationConfig fields a spec may set (the algorithm and its options).
-SPEC_KEYS = ("subsamples", "coefficients", "structure", "rk4_step", "alpha", "beta", "step",
-             "exact_exp")
-_ALIASES = {"N": "subsamples", "n": "subsamples"}
-_INT = {"subsamples"}
-_FLOAT = {"alpha", "beta", "step"}
-_BOOL = {"exact_exp"}
-
-
-def parse_spec(spec: str) -> dict:
-    """``"rotvec:N=3:structure=realtime"`` → ``{"algorithm": "rotvec", "subsamples": 3, ...}``."""
-    if not isinstance(spec, str) or not spec.strip():
-        raise ValueError(f"an algorithm spec must be a non-empty string, got {spec!r}")
-    name, *opts = [p.strip() for p in spec.split(":")]
-    if name not in ALGORITHMS:
-        raise ValueError(f"spec {spec!r}: unknown algorithm {name!r}; choose one of "
-                         f"{', '.join(ALGORITHMS)}")
-    out: dict = {"algorithm": name}
-    for o in opts:
-        key, eq, value = o.partition("=")
-        key = _ALIASES.get(key.strip(), key.strip())
-        if not eq or key not in SPEC_KEYS:
-            raise ValueError(f"spec {spec!r}: {o!r} is not key=value with a key among "
-                             f"N, {', '.join(SPEC_KEYS)}")
-        value = value.strip()
-        try:
-            if key in _INT:
-                out[key] = int(value)
-            elif key in _FLOAT:
-                out[key] = float(value)
-            elif key in _BOOL:
-                if value.lower() not in ("true", "false", "1", "0"):
-                    raise ValueError(value)
-                out[key] = value.lower() in ("true", "1")
-            else:
-                out[key] = value
-        except ValueError:
-            raise ValueError(f"spec {spec!r}: bad value {value!r} for {key}") from None
-    return out
-
+__all__ = ["AlgorithmRun", "compare_log", "compare_motion"]
 
 @dataclass(frozen=True)
 class AlgorithmRun:
@@ -147,32 +107,12 @@ def _errors_against(t_ref, q_ref, t, q) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _run_on_log(log, fields, q0):
-    from strapdown.algorithms import rate
-    from strapdown.algorithms.coning import coefficient_set
-    from strapdown.algorithms.structures import run_structure
-
-    alg = fields["algorithm"]
-    structure = fields.get("structure", "conventional")
-    if alg in RATE_ALGORITHMS:
-        if log.kind != "rate":
-            raise ValueError(f"{alg} takes rate samples; this log holds increments")
-        sol = rate.rate_attitude(log.t, log.data, algorithm=alg, structure=structure,
-                                 coefficients=fields.get("coefficients") or "derived",
-                                 rk4_step=fields.get("rk4_step", "2td"), q0=q0)
-        return sol, rate.update_period(alg, log.h, structure=structure,
-                                       rk4_step=fields.get("rk4_step", "2td"))
-    if alg != "rotvec":
-        raise ValueError(f"{alg} runs on reference motions only (its input is the Krylov model's "
-                         "increments at thirds or halves of a step); use rotvec or a rate "
-                         "algorithm on a log")
-    if log.kind != "increment":
-        raise ValueError("rotvec takes increments; this log holds rates")
-    n = fields.get("subsamples", 3)
-    cs = coefficient_set(fields.get("coefficients") or "table3", n)
-    sol = run_structure(structure, log.data, cs, h=log.h, t0=float(log.t[0]) - log.h, q0=q0)
-    from strapdown.analysis import update_period
-
-    return sol, update_period(structure, n, log.h)
+    spec = AlgorithmSpec(**fields)
+    if spec.family.stepped:
+        raise ValueError(f"{spec.algorithm} runs on reference motions only (its input is the "
+                         "Krylov model's increments at thirds or halves of a step); use rotvec "
+                         "or a rate algorithm on a log")
+    return spec.run(log, q0=q0), spec.update_period(log.h)
 
 
 def compare_log(imu, specs, out, *, kind: str, units: str | None,

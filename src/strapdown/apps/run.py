@@ -18,7 +18,7 @@ import numpy as np
 from tqdm import tqdm
 
 from strapdown._core.validation import first_bad_step
-from strapdown.algorithms.coning import coefficient_set
+from strapdown.algorithms.spec import AlgorithmSpec, algorithms_taking
 from strapdown.algorithms.streaming import RotvecStream
 from strapdown.io import read_imu
 from strapdown.io.files import atomic_path
@@ -120,22 +120,26 @@ def run_log(imu, out, *, kind: str, units: str | None, algorithm: str = "rotvec"
         raise ValueError(f"angles must be ypr, cone or none, got {angles!r}")
     if on_gap not in ("report", "error", "split"):
         raise ValueError(f"on_gap must be report, error or split, got {on_gap!r}")
-    if algorithm == "rotvec" and kind != "increment":
-        raise ValueError("rotvec takes increments (--increments); for rate logs use "
-                         "rate-single, rate-three or rk4")
-    if algorithm != "rotvec" and kind != "rate":
+    spec = AlgorithmSpec(algorithm, subsamples=subsamples, coefficients=coefficients,
+                         structure=structure)
+    if spec.family.stepped:
+        raise ValueError(f"{algorithm} runs on reference motions only (its input is the Krylov "
+                         "model's increments at thirds or halves of a step)")
+    if spec.input_kind == "increment" and kind != "increment":
+        raise ValueError(f"{algorithm} takes increments (--increments); for rate logs use "
+                         f"{', '.join(algorithms_taking('rate'))}")
+    if spec.input_kind == "rate" and kind != "rate":
         raise ValueError(f"{algorithm} takes rate samples (--rates)")
     read = {"kind": kind, "units": units, "columns": columns, "sample_rate_hz": sample_rate_hz,
             "gap_tolerance": gap_tolerance, "on_gap": "error" if on_gap == "error" else "report",
             "saturation": saturation}
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        if algorithm != "rotvec":
-            res = _run_rates(imu, out, read, algorithm, structure, coefficients, angles, q0,
-                             on_gap == "split")
+        if spec.input_kind == "rate":
+            res = _run_rates(imu, out, read, spec, angles, q0, on_gap == "split")
         else:
-            res = _run_increments(imu, out, read, structure, coefficient_set(
-                coefficients or "table3", subsamples), angles, q0, on_gap == "split", progress)
+            res = _run_increments(imu, out, read, structure, spec.family.coefficient_set(spec),
+                                  angles, q0, on_gap == "split", progress)
     res["warnings"] = [str(w.message) for w in caught]
     return res
 
@@ -193,8 +197,7 @@ def _run_increments(imu, out, read, structure, cs, angles, q0, split, progress):
     return {"samples": n_in, "outputs": n_out, "gaps": gaps, "saturated": saturated}
 
 
-def _run_rates(imu, out, read, algorithm, structure, coefficients, angles, q0, split):
-    from strapdown.algorithms import rate
+def _run_rates(imu, out, read, spec, angles, q0, split):
     from strapdown.io import write_attitude
 
     log = read_imu(imu, **read)
@@ -202,9 +205,7 @@ def _run_rates(imu, out, read, algorithm, structure, coefficients, angles, q0, s
     ts, qs, segs = [], [], []
     q_last = q0
     for k, c in enumerate(cuts):
-        sol = rate.rate_attitude(log.t[c], log.data[c], algorithm=algorithm,
-                                 structure=structure, coefficients=coefficients or "derived",
-                                 q0=q_last)
+        sol = spec.run_rates(log.t[c], log.data[c], q0=q_last)
         ts.append(sol.t)
         qs.append(sol.q)
         segs.append(np.full(sol.t.size, float(k)))

@@ -55,8 +55,8 @@ from pathlib import Path
 
 import numpy as np
 
+from strapdown.algorithms.spec import parse_spec
 from strapdown.analysis.evaluate import EvaluationConfig, evaluate
-from strapdown.apps.compare import parse_spec
 from strapdown.io.files import atomic_path, csv_table, write_text
 from strapdown.truth.sensors import GyroErrors
 

@@ -468,7 +468,8 @@ class Design:
             self.order)
 
     def coefficient_set(self, name: str | None = None) -> CoefficientSet:
-        """As a :class:`~strapdown.algorithms.coning.CoefficientSet` (interval increment structures only)."""
+        """As a :class:`~strapdown.algorithms.coning.CoefficientSet` (interval increment
+        structures only)."""
         st = self.structure
         if st.input != "increment" or st.update != len(st.nodes) or st.nodes[0] != 0:
             raise ValueError(
