@@ -25,8 +25,8 @@ demo: $(STAMP)
 	$(VENV)/bin/strapdown reproduce li2017 --out $(DEMO_OUT)
 	@echo "Report: $(DEMO_OUT)/report.md"
 
-## test: install dev extras and run the whole suite
-test: $(DEVSTAMP)
+## test: install dev extras, lint (style, import layers, types), run the whole suite
+test: lint
 	$(PY) -m pytest -q
 
 ## bench: throughput benchmarks with peers (numbers are reported, never asserted)
@@ -34,9 +34,11 @@ bench: $(STAMP)
 	$(PY) -m pip install --quiet -e ".[bench]"
 	$(PY) benchmarks/run.py --out reports/bench.json
 
-## lint: ruff
+## lint: ruff (style), import-linter (imports only point down the layers), mypy (types)
 lint: $(DEVSTAMP)
 	$(VENV)/bin/ruff check src tests benchmarks
+	$(VENV)/bin/lint-imports
+	$(VENV)/bin/mypy
 
 clean:
 	rm -rf $(VENV) build reports .pytest_cache
