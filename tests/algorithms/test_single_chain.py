@@ -11,8 +11,8 @@ from strapdown._core.backend import NUMPY
 from strapdown.algorithms import _reference
 from strapdown.algorithms.coning import coefficient_set
 from strapdown.algorithms.structures import single_chain, single_chain_coefficients
+from strapdown.analysis.coning_drift import drift_mp
 from strapdown.analysis.evaluate import EvaluationConfig, evaluate
-from strapdown.reproduce.li2017 import drift_mp
 
 
 def test_matches_plain_reference_with_startup():

@@ -13,7 +13,9 @@ middle rate is the middle sample, as :mod:`strapdown.algorithms.rate` documents)
     past it; if δ2 later falls below ``switch``, it hands back.
 ``cone-printed``
     Eq. 7 exactly as printed (row 1 sign wrong), same singularity treatment:
-    kept to show that it fails.
+    kept to show that it fails
+    (:func:`strapdown.algorithms.errata.printed_cone_rates`, with its measured
+    difference).
 ``nutation``
     Non-singular: ``C_c_b = exp([ν×]) Rx(δ3)``, ``ν = δ2 (0, −sin δ1, cos δ1)``;
     ``[e_x, J_r(ν) e_y, J_r(ν) e_z] (δ̇3, ν̇_y, ν̇_z)ᵀ = Rx(δ3) ω`` (J_r the
@@ -33,6 +35,7 @@ import numpy as np
 
 from strapdown._core.validation import positive
 from strapdown.algorithms import _kernels
+from strapdown.algorithms.errata import printed_cone_rates
 from strapdown.algorithms.rate import check_rate_record
 from strapdown.rotation.cone_angles import cone_angles_from_dcm, dcm_from_cone_angles
 from strapdown.rotation.euler import _rx, dcm_from_euler_zyx, euler_zyx_from_dcm
@@ -61,11 +64,11 @@ def right_jacobian(nu: np.ndarray) -> np.ndarray:
     return np.eye(3) - c1 * k + c2 * (k @ k)
 
 
-def _cone_rates(y, w, printed):
+def _cone_rates(y, w):
     d1, d2, d3 = y
     e = d1 - d3
     a = np.cos(e) * w[1] + np.sin(e) * w[2]
-    r1 = (a if printed else -a) / np.sin(d2)
+    r1 = -a / np.sin(d2)
     return np.array([r1, -np.sin(e) * w[1] + np.cos(e) * w[2], w[0] - np.tan(d2 / 2) * a])
 
 
@@ -171,7 +174,7 @@ def integrate_cone_angles_reference(t, omega, initial, *, method: str = "cone",
             y = _rk4(_nutation_rates, y, w[2 * k], w[2 * k + 1], w[2 * k + 2], h)
             out[k + 1] = _from_nutation(y)
         return ConeAngleSolution(rec.t[0] + np.arange(steps + 1) * h, _unwrap(out), method, 0)
-    printed = method == "cone-printed"
+    rates = printed_cone_rates if method == "cone-printed" else _cone_rates
     state = d0.copy()
     singular = np.sin(state[1]) < switch
     y = _to_nutation(state) if singular else state
@@ -183,7 +186,7 @@ def integrate_cone_angles_reference(t, omega, initial, *, method: str = "cone",
             if np.sin(state[1]) >= switch:
                 singular, y, switches = False, state.copy(), switches + 1
         else:
-            y = _rk4(lambda s, ww: _cone_rates(s, ww, printed), y, *args)
+            y = _rk4(rates, y, *args)
             state = y
             if np.sin(state[1]) < switch:
                 singular, y, switches = True, _to_nutation(state), switches + 1

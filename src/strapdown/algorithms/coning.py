@@ -15,8 +15,10 @@ with an upper-triangular coefficient matrix ``K`` (``K[i, j]`` multiplies
     The same lag sums ``K_m = ς_m`` spread evenly over all ``N − m`` pairs of
     lag ``m`` — same leading drift under classical coning.
 ``eq6-printed``
-    Eq. 6 exactly as printed, ``Σ_{i<j} ς_i θ_i × θ_j``. Kept so the report can
-    show that it drifts 10⁵–10¹² times faster than Table 1 for N ≥ 3.
+    Eq. 6 exactly as printed, ``Σ_{i<j} ς_i θ_i × θ_j``
+    (:func:`strapdown.algorithms.errata.eq6_printed_matrix`, with its measured
+    difference). Kept so the report can show that it drifts 10⁵–10¹² times
+    faster than Table 1 for N ≥ 3.
 ``miller``
     Miller (1983) three-sample set: ``33/80 θ1×θ3 + 57/80 θ2×(θ3 − θ1)``.
 ``none``
@@ -34,18 +36,17 @@ from fractions import Fraction
 import numpy as np
 
 from strapdown._core.validation import as_vectors, finite_array, positive_int
+from strapdown.algorithms.errata import eq6_printed_matrix
 
 __all__ = [
     "MAX_SUBSAMPLES",
     "TABLE3",
-    "TABLE7",
     "CoefficientSet",
     "WindowedAlgorithm",
     "coefficient_set",
     "coefficient_set_names",
     "rotation_vectors",
     "table1_drift_constant",
-    "triple_cross_rotation_vectors",
     "user_coefficients",
 ]
 
@@ -140,10 +141,7 @@ def _lag(n):
 
 
 def _eq6(n):
-    k = _zeros(n)
-    for i, s in enumerate(TABLE3[n]):
-        for j in range(i + 1, n):
-            k[i][j] = s
+    k = eq6_printed_matrix(TABLE3[n])
     return _from_exact("eq6-printed", k, "Li & Zhang 2017 eq. 6 as printed", n <= 2)
 
 
@@ -294,44 +292,3 @@ class WindowedAlgorithm:
                 phi += (sb * float(c)) * np.cross(s[:, i], s[:, j])
         return phi
 
-
-#: Zhang & Yu 2021 Table 7 (coefficients quoted from Wang et al. 2015). The structure
-#: they multiply is inferred (papers.md), not quoted:
-#: φ = Σθ + k11 θ1×θ3 + k12 θ2×(θ3 − θ1) + Σ_{m; ij ∈ {12, 23, 13}} k_mij θm × (θi × θj).
-TABLE7 = {
-    "k11": 0.45, "k12": 0.675,
-    "k112": -1.2229, "k212": 1.0021, "k312": 0.0396,
-    "k123": -0.3771, "k223": 1.2354, "k323": -0.3396,
-    "k113": 1.1562, "k213": -0.7625, "k313": 0.0,
-}
-
-
-def triple_cross_rotation_vectors(increments, coefficients: dict | None = None,
-                                  *, triple: bool = True) -> np.ndarray:
-    """Three-subsample rotation vectors with the triple-cross-product terms of Table 7.
-
-    ``φ = Σθ + k11 θ1×θ3 + k12 θ2×(θ3 − θ1) [+ Σ k_mij θm × (θi × θj)]`` for each
-    group of three increments; ``triple=False`` drops the triple terms (the plain
-    three-subsample set with the same k11, k12).
-    """
-    k = dict(TABLE7 if coefficients is None else coefficients)
-    unknown = set(k) - set(TABLE7)
-    if unknown:
-        raise ValueError(f"unknown Table 7 coefficient(s) {sorted(unknown)}; "
-                         f"expected {sorted(TABLE7)}")
-    theta = as_vectors(increments, "increments")
-    if theta.ndim != 2 or theta.shape[0] < 3 or theta.shape[0] % 3:
-        raise ValueError(f"increments must have shape (3·M, 3), got {theta.shape}")
-    g = theta.reshape(-1, 3, 3)
-    t = [g[:, 0], g[:, 1], g[:, 2]]
-    phi = g.sum(axis=1) + k.get("k11", 0.0) * np.cross(t[0], t[2]) + k.get("k12", 0.0) * np.cross(
-        t[1], t[2] - t[0])
-    if triple:
-        pairs = {"12": np.cross(t[0], t[1]), "23": np.cross(t[1], t[2]),
-                 "13": np.cross(t[0], t[2])}
-        for ij, c in pairs.items():
-            for m in range(3):
-                coef = k.get(f"k{m + 1}{ij}", 0.0)
-                if coef:
-                    phi = phi + coef * np.cross(t[m], c)
-    return phi

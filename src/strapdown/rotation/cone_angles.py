@@ -12,10 +12,10 @@ for δ2 ≤ π/2, ``δ3 = atan2(C32 − C23, C22 + C33)`` (these equal
 is lost and is returned as 0); for δ2 > π/2, ``2δ1 − δ3 = atan2(−(C32 + C23),
 C33 − C22)`` (these equal ``(1 − cos δ2)(−sin, cos)(2δ1 − δ3)``).
 
-The paper's own conversions are kept under ``paper_*`` names so the report
-can show where they fail: eq. 19 (``arccos C11``) loses all precision near
-δ2 = 0; Table 2's quadrant logic for δ3 is wrong; eqs. 21–22 give the
-negative of the z-y-x pitch and a wrong yaw beyond δ2 = 90°.
+The paper's own conversions are kept, with their measured failures, in
+:mod:`strapdown.algorithms.errata` (``paper_*``): eq. 19 (``arccos C11``) loses
+all precision near δ2 = 0; Table 2's quadrant logic for δ3 is wrong; eqs. 21–22
+give the negative of the z-y-x pitch and a wrong yaw beyond δ2 = 90°.
 """
 
 from __future__ import annotations
@@ -30,9 +30,6 @@ __all__ = [
     "cone_angles_from_dcm",
     "cone_angles_from_quat",
     "dcm_from_cone_angles",
-    "paper_cone_angles_from_dcm",
-    "paper_dcm_from_cone_angles",
-    "paper_pitch_yaw_from_cone_angles",
     "pitch_yaw_roll_from_cone_angles",
     "quat_from_cone_angles",
 ]
@@ -73,47 +70,3 @@ def pitch_yaw_roll_from_cone_angles(d1, d2, d3) -> tuple[np.ndarray, np.ndarray,
     """z-y-x (yaw, pitch, roll) of the same attitude, through the DCM (valid for every δ2)."""
     return euler_zyx_from_dcm(dcm_from_cone_angles(d1, d2, d3))
 
-
-# --------------------------------------------------------------- the paper's formulas
-def paper_dcm_from_cone_angles(d1, d2, d3) -> np.ndarray:
-    """Eq. 17 exactly as printed (C32 and C33 carry typos; papers.md)."""
-    d1, d2, d3 = np.broadcast_arrays(*(np.asarray(x, float) for x in (d1, d2, d3)))
-    e = d1 - d3
-    c, s = np.cos, np.sin
-    rows = [
-        [c(d2), -c(e) * s(d2), -s(e) * s(d2)],
-        [c(d1) * s(d2), s(e) * s(d1) + c(e) * c(d1) * c(d2), -c(e) * s(d1) + s(e) * c(d1) * c(d2)],
-        [s(d1) * s(d2), -s(e) * c(d1) + c(e) * c(d1) * s(d2), c(e) * c(d1) + s(e) * c(d1) * s(d2)],
-    ]
-    return np.stack([np.stack(r, -1) for r in rows], -2)
-
-
-def paper_cone_angles_from_dcm(dcm) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Eqs. 18–20 with Tables 1 and 2 exactly as printed (arccos for δ2, arctan quadrants)."""
-    c = as_dcms(dcm, "dcm")
-    c11, c12, c13 = c[..., 0, 0], c[..., 0, 1], c[..., 0, 2]
-    c21, c31 = c[..., 1, 0], c[..., 2, 0]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        d1h = np.arctan(c31 / c21)
-        d3h = np.arctan(c13 / c12)
-    d2 = np.arccos(np.clip(c11, -1.0, 1.0))
-    d1 = np.select([(c21 >= 0) & (c31 >= 0), (c21 < 0) & (c31 < 0), (c21 < 0) & (c31 >= 0)],
-                   [d1h, d1h + np.pi, d1h + np.pi], d1h + 2 * np.pi)
-    # Table 2 as printed: δ3 = δ1 + (δ̂3 + …), with δ̂3 read from eq. 20 "δ1 − δ̂3 = arctan(C13/C12)"
-    base = d1 - d3h
-    d3 = np.select([(c12 >= 0) & (c13 >= 0), (c12 >= 0) & (c13 < 0), (c12 < 0) & (c13 < 0)],
-                   [d1 + base, d1 + base + np.pi, d1 + base + np.pi], d1 + base + 2 * np.pi)
-    return d1, d2, np.mod(d3, _TWO_PI)
-
-
-def paper_pitch_yaw_from_cone_angles(d1, d2) -> tuple[np.ndarray, np.ndarray]:
-    """Eqs. 21–22 with the signs of Tables 3–4 (pitch − for δ1 ∈ (180°, 360°); yaw + for
-    δ1 ∈ [0°, 90°] ∪ (270°, 360°])."""
-    d1 = np.mod(np.asarray(d1, float), _TWO_PI)
-    d2 = np.asarray(d2, float)
-    theta = np.arcsin(np.abs(np.sin(d1) * np.sin(d2)))
-    theta = np.where(d1 > np.pi, -theta, theta)
-    arg = (np.sin(d2) ** 2 - np.sin(theta) ** 2) / np.cos(theta) ** 2
-    psi = np.arcsin(np.sqrt(np.clip(arg, 0.0, 1.0)))
-    psi = np.where((d1 <= np.pi / 2) | (d1 > 1.5 * np.pi), psi, -psi)
-    return theta, psi

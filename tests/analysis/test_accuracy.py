@@ -1,4 +1,5 @@
-"""Issue-level accuracy claims, against closed forms and arbitrary-precision runs.
+"""Accuracy claims (Li & Zhang (2017) Tables 1–3, the round-off floor), against closed forms
+and arbitrary-precision runs.
 
 Ωh = 2π/240 ≈ 0.026 and 2π/60 ≈ 0.105 so that every N = 1 … 5 update lands on
 whole cone periods (drift sampled there, conventions.md).
@@ -12,8 +13,8 @@ import numpy as np
 import pytest
 
 from strapdown import analysis
+from strapdown.analysis.coning_drift import drift_f64, drift_mp
 from strapdown.analysis.evaluate import EvaluationConfig, evaluate
-from strapdown.reproduce.li2017 import drift_f64, drift_mp
 
 A_SMALL = 1e-6
 A_1DEG = math.radians(1.0)
@@ -40,7 +41,8 @@ def test_float64_agrees_with_arbitrary_precision_at_one_degree(spp, n):
 
 
 def test_table1_law_fails_at_one_degree_for_n3_small_omega_h():
-    # The a⁴ term dominates (papers.md): the law must not be assumed.
+    # The a⁴ term dominates (Table 1 of Li & Zhang (2017) is leading order in a): the law
+    # must not be assumed.
     ratio = drift_mp(A_1DEG, 240, 3, "conventional") / law(A_1DEG, 240, 3)
     assert not 0.5 <= ratio <= 2.0
 
