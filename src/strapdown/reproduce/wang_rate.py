@@ -18,7 +18,6 @@ deriving them, ``derived`` = our designer).
 from __future__ import annotations
 
 import math
-import time
 from collections.abc import Callable
 from pathlib import Path
 
@@ -26,9 +25,9 @@ import numpy as np
 
 from strapdown import analysis
 from strapdown.algorithms import rate
+from strapdown.algorithms.spec import AlgorithmSpec
 from strapdown.analysis.evaluate import EvaluationConfig, evaluate
-from strapdown.io.files import write_text
-from strapdown.io.report import ReportWriter, begin_report
+from strapdown.io.report import Report
 from strapdown.truth import sensors
 from strapdown.truth.motions import ClassicalConing
 
@@ -55,88 +54,16 @@ def _cfg(alg, structure, coeffs, step, **kw):
 
 def reproduce(out: str | Path, *, progress: Callable[[str], None] | None = None) -> Path:
     """Run the study and write it to ``out``; returns the path of ``report.md``."""
-    out, w, say, plt, t0 = begin_report(out, progress)
-    md: list[str] = []
-
-    # ---------------------------------------------------------------- orders
-    say("drift orders in arbitrary precision")
-    rows = []
-    curves = {}
-    for label, alg, st, coeffs, step, claimed in ALGS:
-        order, c = rate.predicted_drift_law(alg, coefficients=coeffs or "derived", rk4_step=step)
-        xs, ds, ratios = [], [], []
-        for spp in SPP:
-            r = evaluate(_cfg(alg, st, coeffs, step, half_angle_deg=math.degrees(A_SMALL),
-                              sample_rate_hz=spp, duration=2.0, precision=DIGITS))
-            xs.append(2 * math.pi / spp)
-            ds.append(r.cone_axis_drift)
-            ratios.append(r.cone_axis_drift / r.predicted)
-        slope = float(np.polyfit(np.log(xs), np.log(np.abs(ds)), 1)[0])
-        curves[label] = (np.array(xs), np.array(ds), order, c)
-        rows.append([label, "—" if claimed is None else claimed, order,
-                     f"{c.numerator}/{c.denominator}", f"{slope:.3f}",
-                     f"{min(ratios):.4f} … {max(ratios):.4f}",
-                     "agrees" if abs(slope - order) <= 0.2 else "DIFFERS"])
-    md.append("## Drift orders under classical coning\n\n"
-              "Drift about the cone axis = −c · a²Ω(Ωtd)^order. *Claimed*: what a derivation "
-              "that fits the coning term alone (the seed's method) gives; *derived*: the "
-              "designer with the quadrature error of α included (the true law); *fitted*: "
-              "least-squares slope of log|drift| against log Ωtd from arbitrary-precision "
-              f"simulations ({DIGITS} digits) at a = 1e-9 rad, Ωtd = 2π/600 … 2π/60 (a "
-              "decade).\n\n")
-    md.append(w.table("orders", ["algorithm", "claimed order", "derived order", "c",
-                                 "fitted order", "measured/derived law (4 Ωtd)", "verdict"],
-                      rows))
-
-    fig, ax = plt.subplots(figsize=(7.5, 5.5))
-    xl = np.geomspace(2 * math.pi / 700, 2 * math.pi / 50, 40)
-    for (label, (xs, ds, order, c)), col in zip(curves.items(),
-                                                plt.cm.tab10(np.arange(len(curves))),
-                                                strict=True):
-        norm = A_SMALL**2 * 2 * math.pi
-        ax.loglog(xs, np.abs(ds) / norm, "o", color=col, mfc="none")
-        ax.loglog(xl, abs(float(c)) * xl**order, "-", color=col, lw=1,
-                  label=f"{label}: order {order}")
-    ax.set_xlabel("Ωtd (rad)")
-    ax.set_ylabel("|drift| / (a²Ω)")
-    ax.set_title("Rate-input algorithms under classical coning (points: simulation)")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=7)
-    w.figure("drift_vs_omega_td.png", fig)
-    md.append("\n![drift versus Ωtd](drift_vs_omega_td.png)\n")
-
-    # ------------------------------------------------------- sliding = three
-    say("sliding scheme against the three-period algorithm")
-    rows = []
-    for precision, a_deg, dur in ((None, 1.0, 6.0), (60, 1.0, 2.0), (60, math.degrees(1e-6),
-                                                                    2.0)):
-        kw = dict(half_angle_deg=a_deg, sample_rate_hz=120.0, duration=dur, precision=precision)
-        conv = evaluate(_cfg("rate-three", "conventional", None, "2td", **kw))
-        sl = evaluate(_cfg("rate-three", "sliding", None, "2td", **kw))
-        rows.append(["float64" if precision is None else f"{precision} digits", f"{a_deg:.3g}",
-                     f"{conv.cone_axis_drift:.6e}", f"{sl.cone_axis_drift:.6e}",
-                     f"{abs(sl.cone_axis_drift / conv.cone_axis_drift - 1):.1e}",
-                     f"{conv.update_period * 1e3:.3g} / {sl.update_period * 1e3:.3g}"])
-    md.append("\n## The sliding scheme drifts exactly like the three-period algorithm\n\n"
-              "Ωtd = 2π/120, classical coning at 1 Hz, noise-free. The sliding scheme is three "
-              "interleaved three-period chains started by single-period steps: it triples the "
-              "output rate, not the accuracy.\n\n")
-    md.append(w.table("sliding_vs_three", ["arithmetic", "a (deg)", "three-period (rad/s)",
-                                           "sliding (rad/s)", "relative difference",
-                                           "update period (ms)"], rows))
-
-    # ---------------------------------------------------------- sawtooth
-    say("sliding chains under gyro noise")
-    md.append(_sawtooth(w, plt))
-
-    # ------------------------------------------------- rate vs increments
-    say("rate input against increment input")
-    md.append(_rate_vs_increment(w))
-
-    elapsed = time.perf_counter() - t0
+    r = Report.begin(out, progress)
+    _orders_figure(r, _orders(r))
+    _sliding_vs_three(r)
+    r.say("sliding chains under gyro noise")
+    r.add(_sawtooth(r))
+    r.say("rate input against increment input")
+    r.add(_rate_vs_increment(r))
     report = [
         "# Rate-input attitude algorithms (Wang, Wang & Wang) — orders, sliding scheme, noise\n",
-        f"Generated by `strapdown reproduce wang-rate` in {elapsed:.0f} s. Algorithms as "
+        f"Generated by `strapdown reproduce wang-rate` in {r.elapsed():.0f} s. Algorithms as "
         "reconstructed in papers.md (the seed's equations were lost in extraction).\n",
         "## Summary\n",
         "- With rate input, the quadrature of α biases the rotation vector at the same order "
@@ -152,15 +79,93 @@ def reproduce(out: str | Path, *, progress: Callable[[str], None] | None = None)
         "weights give each sample a different weight in each chain.",
         "- At equal sample rate, increment input beats rate input: the increments carry the "
         "exact integral between samples (`rate_vs_increment.csv`).\n",
-        *md,
+        *r.parts,
         "\n## Files\n",
-        *w.file_list(),
+        *r.file_list(),
         "",
     ]
-    return write_text(out / "report.md", "\n".join(report))
+    return r.write("\n".join(report))
 
 
-def _sawtooth(w: ReportWriter, plt) -> str:
+def _orders(r: Report) -> dict:
+    """Drift orders in arbitrary precision; returns ``{label: (Ωtd, drift, order, c)}``."""
+    r.say("drift orders in arbitrary precision")
+    rows = []
+    curves = {}
+    for label, alg, st, coeffs, step, claimed in ALGS:
+        law = AlgorithmSpec(alg, coefficients=coeffs, rk4_step=step).drift_law()
+        order, c = law.order, law.constant
+        xs, ds, ratios = [], [], []
+        for spp in SPP:
+            res = evaluate(_cfg(alg, st, coeffs, step, half_angle_deg=math.degrees(A_SMALL),
+                                sample_rate_hz=spp, duration=2.0, precision=DIGITS))
+            xs.append(2 * math.pi / spp)
+            ds.append(res.cone_axis_drift)
+            ratios.append(res.cone_axis_drift / res.predicted)
+        slope = float(np.polyfit(np.log(xs), np.log(np.abs(ds)), 1)[0])
+        curves[label] = (np.array(xs), np.array(ds), order, c)
+        rows.append([label, "—" if claimed is None else claimed, order,
+                     f"{c.numerator}/{c.denominator}", f"{slope:.3f}",
+                     f"{min(ratios):.4f} … {max(ratios):.4f}",
+                     "agrees" if abs(slope - order) <= 0.2 else "DIFFERS"])
+    r.add("## Drift orders under classical coning\n\n"
+          "Drift about the cone axis = −c · a²Ω(Ωtd)^order. *Claimed*: what a derivation "
+          "that fits the coning term alone (the seed's method) gives; *derived*: the "
+          "designer with the quadrature error of α included (the true law); *fitted*: "
+          "least-squares slope of log|drift| against log Ωtd from arbitrary-precision "
+          f"simulations ({DIGITS} digits) at a = 1e-9 rad, Ωtd = 2π/600 … 2π/60 (a "
+          "decade).\n\n")
+    r.add(r.table("orders", ["algorithm", "claimed order", "derived order", "c",
+                             "fitted order", "measured/derived law (4 Ωtd)", "verdict"],
+                  rows))
+    return curves
+
+
+def _orders_figure(r: Report, curves: dict) -> None:
+    """Figure: drift against Ωtd, simulation points beside each algorithm's law."""
+    plt = r.plt
+    fig, ax = plt.subplots(figsize=(7.5, 5.5))
+    xl = np.geomspace(2 * math.pi / 700, 2 * math.pi / 50, 40)
+    for (label, (xs, ds, order, c)), col in zip(curves.items(),
+                                                plt.cm.tab10(np.arange(len(curves))),
+                                                strict=True):
+        norm = A_SMALL**2 * 2 * math.pi
+        ax.loglog(xs, np.abs(ds) / norm, "o", color=col, mfc="none")
+        ax.loglog(xl, abs(float(c)) * xl**order, "-", color=col, lw=1,
+                  label=f"{label}: order {order}")
+    ax.set_xlabel("Ωtd (rad)")
+    ax.set_ylabel("|drift| / (a²Ω)")
+    ax.set_title("Rate-input algorithms under classical coning (points: simulation)")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7)
+    r.figure("drift_vs_omega_td.png", fig)
+    r.add("\n![drift versus Ωtd](drift_vs_omega_td.png)\n")
+
+
+def _sliding_vs_three(r: Report) -> None:
+    """The sliding scheme against the three-period algorithm, float64 and arbitrary precision."""
+    r.say("sliding scheme against the three-period algorithm")
+    rows = []
+    for precision, a_deg, dur in ((None, 1.0, 6.0), (60, 1.0, 2.0), (60, math.degrees(1e-6),
+                                                                    2.0)):
+        kw = dict(half_angle_deg=a_deg, sample_rate_hz=120.0, duration=dur, precision=precision)
+        conv = evaluate(_cfg("rate-three", "conventional", None, "2td", **kw))
+        sl = evaluate(_cfg("rate-three", "sliding", None, "2td", **kw))
+        rows.append(["float64" if precision is None else f"{precision} digits", f"{a_deg:.3g}",
+                     f"{conv.cone_axis_drift:.6e}", f"{sl.cone_axis_drift:.6e}",
+                     f"{abs(sl.cone_axis_drift / conv.cone_axis_drift - 1):.1e}",
+                     f"{conv.update_period * 1e3:.3g} / {sl.update_period * 1e3:.3g}"])
+    r.add("\n## The sliding scheme drifts exactly like the three-period algorithm\n\n"
+          "Ωtd = 2π/120, classical coning at 1 Hz, noise-free. The sliding scheme is three "
+          "interleaved three-period chains started by single-period steps: it triples the "
+          "output rate, not the accuracy.\n\n")
+    r.add(r.table("sliding_vs_three", ["arithmetic", "a (deg)", "three-period (rad/s)",
+                                       "sliding (rad/s)", "relative difference",
+                                       "update period (ms)"], rows))
+
+
+def _sawtooth(r: Report) -> str:
+    """The sliding scheme's three chains under gyro noise, against one chain."""
     motion = ClassicalConing(math.radians(1.0), 2 * math.pi)
     spp = 600
     td = motion.period / spp
@@ -182,18 +187,7 @@ def _sawtooth(w: ReportWriter, plt) -> str:
         series[label] = (a_sl, a_one)
         rows.append([label, f"{a_sl[0]:.2e}", f"{np.median(a_sl):.2e}", f"{a_sl[-1]:.2e}",
                      f"{np.median(a_one):.2e}"])
-    fig, ax = plt.subplots(figsize=(7.5, 4))
-    for (label, (a_sl, a_one)), col in zip(series.items(), ("C0", "C1", "C2"), strict=True):
-        k = np.arange(a_sl.size) + 0.5
-        ax.semilogy(k, a_sl, "o-", ms=3, color=col, label=f"sliding, {label}")
-        ax.semilogy(k, np.maximum(a_one, 1e-22), "--", color=col, lw=1,
-                    label=f"single-period (one chain), {label}")
-    ax.set_xlabel("cone period")
-    ax.set_ylabel("3-periodic component (rad)")
-    ax.set_title("Sliding three-period scheme: sawtooth amplitude per cone period")
-    ax.grid(alpha=0.3, which="both")
-    ax.legend(fontsize=6, ncol=2)
-    w.figure("sliding_sawtooth.png", fig)
+    _sawtooth_figure(r, series)
     a_sl, a_one = series["0.01 °/s/√Hz"]
     ratio = float(np.median(a_sl) / np.median(a_one))
     growth = float(np.mean(a_sl[-5:]) / np.mean(a_sl[:5]))
@@ -203,7 +197,7 @@ def _sawtooth(w: ReportWriter, plt) -> str:
             "cone-axis error is regressed on a trend plus one constant per chain; the last "
             "column applies the same regression to the single-period algorithm (one chain, "
             "same samples) as the noise baseline.\n\n"
-            + w.table("sliding_sawtooth", ["gyro white noise", "sliding: first period",
+            + r.table("sliding_sawtooth", ["gyro white noise", "sliding: first period",
                                            "sliding: median", "sliding: last period",
                                            "one chain: median"], rows)
             + "\nNoise-free, the start-up leaves the three chains with constant offsets that "
@@ -218,7 +212,24 @@ def _sawtooth(w: ReportWriter, plt) -> str:
             "weight 1.)\n\n![sliding sawtooth](sliding_sawtooth.png)\n")
 
 
-def _rate_vs_increment(w: ReportWriter) -> str:
+def _sawtooth_figure(r: Report, series: dict) -> None:
+    """Figure: the 3-periodic component per cone period, sliding against one chain."""
+    fig, ax = r.plt.subplots(figsize=(7.5, 4))
+    for (label, (a_sl, a_one)), col in zip(series.items(), ("C0", "C1", "C2"), strict=True):
+        k = np.arange(a_sl.size) + 0.5
+        ax.semilogy(k, a_sl, "o-", ms=3, color=col, label=f"sliding, {label}")
+        ax.semilogy(k, np.maximum(a_one, 1e-22), "--", color=col, lw=1,
+                    label=f"single-period (one chain), {label}")
+    ax.set_xlabel("cone period")
+    ax.set_ylabel("3-periodic component (rad)")
+    ax.set_title("Sliding three-period scheme: sawtooth amplitude per cone period")
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=6, ncol=2)
+    r.figure("sliding_sawtooth.png", fig)
+
+
+def _rate_vs_increment(r: Report) -> str:
+    """Rate input against increment input at the same sample rate (arbitrary precision)."""
     rows = []
     for rate_hz in (600.0, 120.0):
         cases = [
@@ -236,17 +247,17 @@ def _rate_vs_increment(w: ReportWriter) -> str:
             ("rates: RK4 step 2td", dict(algorithm="rk4")),
         ]
         for label, kw in cases:
-            r = evaluate(EvaluationConfig(half_angle_deg=1.0, cone_rate_hz=1.0,
-                                          sample_rate_hz=rate_hz, duration=2.0, precision=40,
-                                          **kw))
-            rows.append([f"{rate_hz:.0f}", label, f"{r.update_period * 1e3:.3g}",
-                         f"{r.cone_axis_drift:.3e}",
-                         "—" if r.predicted is None else f"{r.predicted:.3e}"])
+            res = evaluate(EvaluationConfig(half_angle_deg=1.0, cone_rate_hz=1.0,
+                                            sample_rate_hz=rate_hz, duration=2.0, precision=40,
+                                            **kw))
+            rows.append([f"{rate_hz:.0f}", label, f"{res.update_period * 1e3:.3g}",
+                         f"{res.cone_axis_drift:.3e}",
+                         "—" if res.predicted is None else f"{res.predicted:.3e}"])
     return ("\n## What the gyro's output type costs: rate input against increment input\n\n"
             "Same sample rate, classical coning a = 1° at 1 Hz, arbitrary precision (40 digits), "
             "drift about the cone axis. At equal sample rate the increment algorithms see the "
             "exact integral of the rate between samples; rate algorithms must reconstruct it, "
             "and their best sets need one more sample per update for the same order.\n\n"
-            + w.table("rate_vs_increment", ["sample rate (Hz)", "algorithm",
+            + r.table("rate_vs_increment", ["sample rate (Hz)", "algorithm",
                                             "update period (ms)", "drift (rad/s)",
                                             "leading-order law (rad/s)"], rows))

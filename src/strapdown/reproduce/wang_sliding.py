@@ -26,7 +26,6 @@ used in its flight test), sensor errors below, field 50 µT / 60° dip.
 from __future__ import annotations
 
 import math
-import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -35,8 +34,7 @@ import numpy as np
 
 from strapdown.ahrs import AhrsConfig, ekf
 from strapdown.algorithms.rate import rate_attitude
-from strapdown.io.files import write_text
-from strapdown.io.report import begin_report
+from strapdown.io.report import Report
 from strapdown.rotation.dcm import dcm_from_quat
 from strapdown.rotation.euler import euler_zyx_from_dcm
 from strapdown.rotation.quaternion import quat_conjugate, quat_multiply, quat_rotate
@@ -133,23 +131,33 @@ def _open_loop(sim: Simulation, spec: str, gyro) -> float:
 
 def reproduce(out: str | Path, *, progress: Callable[[str], None] | None = None) -> Path:
     """Run the study and write it to ``out``; returns the path of ``report.md``."""
-    out, w, say, plt, t0 = begin_report(out, progress)
-    md = ["# Seed 001 — EKF with three attitude algorithms on the loiter flight\n",
+    r = Report.begin(out, progress)
+    r.add("# Seed 001 — EKF with three attitude algorithms on the loiter flight\n",
           "Wang, Wang & Wang: multiplicative EKF (attitude error, gyro bias, Singer manoeuvre "
           "acceleration; papers.md) propagated by algorithm 1 (single-period rotation vector), "
           "2 (quaternion RK4) or 3 (sliding three-period rotation vector). Sensors: gyro "
           "0.05 °/s/√Hz with bias (0.2, −0.3, 0.1) °/s, accelerometer 0.02 m/s²/√Hz with "
           "bias, magnetometer 0.5 µT noise, field 50 µT / 60° dip, "
           f"{RATE_HZ:g} Hz (assumed: the paper does not give its simulation rate), seed 1. "
-          f"Errors are maxima after {SETTLE_S:g} s, from z-y-x angles.\n"]
+          f"Errors are maxima after {SETTLE_S:g} s, from z-y-x angles.\n")
+    rows, fig_data = _flight(r)
+    _flight_verdicts(r, rows)
+    _heading_figure(r, fig_data)
+    _vibration(r)
+    r.add(f"\nRun time {r.elapsed():.0f} s.\n\n## Files\n\n"
+          + "\n".join(r.file_list()) + "\n")
+    return r.write("".join(r.parts))
 
-    # ------------------------------------------------------------ three readings
+
+def _flight(r: Report) -> tuple[list[list], dict]:
+    """The three filters (and the control) on the three readings of the flight; returns the
+    table rows and the first reading's heading errors ``{filter: (t, errors)}``."""
     rows, fig_data = [], {}
     for variant in WANG_VARIANTS:
-        say(f"flight, {variant}")
+        r.say(f"flight, {variant}")
         sim = simulate(variant)
         for label, spec, upd in [*FILTERS, CONTROL]:
-            r, e, keep = _aided(sim, spec)
+            res, e, keep = _aided(sim, spec)
             mx = e[keep].max(axis=0)
             ol = _open_loop(sim, spec, sim.gyro_ideal) if label != CONTROL[0] else math.nan
             rows.append([variant, label, f"{upd} td = {upd / RATE_HZ * 1e3:g} ms",
@@ -157,19 +165,24 @@ def reproduce(out: str | Path, *, progress: Callable[[str], None] | None = None)
                          "—" if math.isnan(ol) else f"{ol:.2e}",
                          " / ".join(f"{v:g}" for v in PRINTED.get(label, ()))])
             if variant == WANG_VARIANTS[0]:
-                fig_data[label] = (sim.t[r.index], e)
-    md.append("## The three filters on the three readings of the flight\n\n"
-              "*Open loop*: the algorithm alone on the ideal (noise-free) gyro, max attitude "
-              "error over the flight — the part of the filter error the algorithm can "
-              "explain.\n\n")
-    md.append(w.table("flight_errors", ["reading", "filter", "update period",
-                                        "max roll (°)", "max pitch (°)", "max heading (°)",
-                                        "open loop (rad)", "printed roll / pitch / heading (°)"],
-                      rows))
+                fig_data[label] = (sim.t[res.index], e)
+    r.add("## The three filters on the three readings of the flight\n\n"
+          "*Open loop*: the algorithm alone on the ideal (noise-free) gyro, max attitude "
+          "error over the flight — the part of the filter error the algorithm can "
+          "explain.\n\n")
+    r.add(r.table("flight_errors", ["reading", "filter", "update period",
+                                    "max roll (°)", "max pitch (°)", "max heading (°)",
+                                    "open loop (rad)", "printed roll / pitch / heading (°)"],
+                  rows))
+    return rows, fig_data
+
+
+def _flight_verdicts(r: Report, rows: list[list]) -> None:
+    """Whether the paper's ordering of the heading errors holds, per reading, and why not."""
     heads = {}
-    for r in rows:
-        if not r[1].startswith("control"):
-            heads.setdefault(r[0], []).append(float(r[5]))
+    for row in rows:
+        if not row[1].startswith("control"):
+            heads.setdefault(row[0], []).append(float(row[5]))
     verdicts = []
     for variant, hs in heads.items():
         order = hs[2] < hs[1] < hs[0]
@@ -178,21 +191,25 @@ def reproduce(out: str | Path, *, progress: Callable[[str], None] | None = None)
                         f"{hs[2]:.3f}° for filters 1 / 2 / 3; the paper's ordering "
                         f"{'holds' if order else 'does not hold'} (largest/smallest = "
                         f"{spread:.2f}, printed 15).")
-    ol_max = max(float(r[6]) for r in rows if r[6] != "—")
-    md.append("\n" + "\n".join(verdicts) + "\n\n"
-              "Why: in the steady turn the body rates are constant — no coning — and every "
-              f"algorithm integrates the flight to {ol_max:.1e} rad or better (open-loop "
-              f"column; {math.degrees(ol_max):.1e}°). "
-              "The filter errors come from sensor noise, bias and the aiding, which are the "
-              "same for all three filters: chiefly the turn's centripetal acceleration, which an "
-              "accelerometer cannot tell from tilt (it leaks into roll until the innovation gate "
-              "closes, and the magnetometer heading inherits the tilt error × tan(dip)). The "
-              "differences between the filters follow the update period, not the algorithm: "
-              "the control row — a different algorithm at RK4's 2 td — matches RK4, and its "
-              "measurement timing changes when the gate closes at turn entry. The printed "
-              "37.4 / 8.3 / 2.5° cannot come from the attitude-update algorithm on this "
-              "flight.\n")
-    fig, ax = plt.subplots(figsize=(8, 4))
+    ol_max = max(float(row[6]) for row in rows if row[6] != "—")
+    r.add("\n" + "\n".join(verdicts) + "\n\n"
+          "Why: in the steady turn the body rates are constant — no coning — and every "
+          f"algorithm integrates the flight to {ol_max:.1e} rad or better (open-loop "
+          f"column; {math.degrees(ol_max):.1e}°). "
+          "The filter errors come from sensor noise, bias and the aiding, which are the "
+          "same for all three filters: chiefly the turn's centripetal acceleration, which an "
+          "accelerometer cannot tell from tilt (it leaks into roll until the innovation gate "
+          "closes, and the magnetometer heading inherits the tilt error × tan(dip)). The "
+          "differences between the filters follow the update period, not the algorithm: "
+          "the control row — a different algorithm at RK4's 2 td — matches RK4, and its "
+          "measurement timing changes when the gate closes at turn entry. The printed "
+          "37.4 / 8.3 / 2.5° cannot come from the attitude-update algorithm on this "
+          "flight.\n")
+
+
+def _heading_figure(r: Report, fig_data: dict) -> None:
+    """Figure: heading error against time on the first reading."""
+    fig, ax = r.plt.subplots(figsize=(8, 4))
     for label, (tt, e) in fig_data.items():
         ax.plot(tt, e[:, 2], lw=0.7, label=label)
     ax.set_xlabel("t (s)")
@@ -200,39 +217,36 @@ def reproduce(out: str | Path, *, progress: Callable[[str], None] | None = None)
     ax.set_title(f"heading error, reading {WANG_VARIANTS[0]}")
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3)
-    md.append(f"\n![heading error]({w.figure('heading_error.png', fig)})\n")
+    r.add(f"\n![heading error]({r.figure('heading_error.png', fig)})\n")
 
-    # ------------------------------------------------------------ vibration
+
+def _vibration(r: Report) -> None:
+    """The speed-bank flight with coning-type vibration: where the algorithm matters."""
     vib = Vibration(0.2, 25.0)
     vib_rate = 200.0
-    say(f"vibration: {vib.half_angle_deg}° coning at {vib.frequency_hz} Hz, {vib_rate:g} Hz")
+    r.say(f"vibration: {vib.half_angle_deg}° coning at {vib.frequency_hz} Hz, {vib_rate:g} Hz")
     sim = simulate("speed-bank", rate_hz=vib_rate, vibration=vib)
     vrows = []
     for label, spec, upd in FILTERS:
-        r, e, keep = _aided(sim, spec)
+        _, e, keep = _aided(sim, spec)
         mx = e[keep].max(axis=0)
         ol = _open_loop(sim, spec, sim.gyro_ideal)
         vrows.append([label, f"{upd / vib_rate * 1e3:g} ms", f"{mx[0]:.3f}", f"{mx[1]:.3f}",
                       f"{mx[2]:.3f}", f"{math.degrees(ol):.3f}"])
-    md.append("\n## Vibration: where the algorithm matters\n\n"
-              f"The speed-bank flight with a coning-type angular vibration of half angle "
-              f"{vib.half_angle_deg}° at {vib.frequency_hz:g} Hz (airframe or engine), sampled "
-              f"at {vib_rate:g} Hz (Ωtd = {2 * math.pi * vib.frequency_hz / vib_rate:.3f}). "
-              "Coning produces a steady drift whose size depends on the algorithm's order; "
-              "the open-loop column is the algorithm alone (ideal gyro, 250 s), the others "
-              "the filter.\n\n")
-    md.append(w.table("vibration_errors", ["filter", "update period", "max roll (°)",
-                                           "max pitch (°)", "max heading (°)",
-                                           "open loop, ideal gyro (°)"], vrows))
-    ols = [float(r[5]) for r in vrows]
-    hs = [float(r[4]) for r in vrows]
-    md.append(f"\nOpen loop the three algorithms drift {ols[0]:.3g}°, {ols[1]:.3g}° and "
-              f"{ols[2]:.3g}° over the flight: here the algorithm matters. The filter bounds "
-              f"the error (accelerometer and magnetometer corrections), leaving max heading "
-              f"errors of {hs[0]:.3g} / {hs[1]:.3g} / {hs[2]:.3g}°; the paper's ordering "
-              f"(3 < 2 < 1) {'holds' if hs[2] < hs[1] < hs[0] else 'does not hold'}.\n")
-    md.append(f"\nRun time {time.perf_counter() - t0:.0f} s.\n\n## Files\n\n"
-              + "\n".join(w.file_list()) + "\n")
-    report = out / "report.md"
-    write_text(report, "".join(md))
-    return report
+    r.add("\n## Vibration: where the algorithm matters\n\n"
+          f"The speed-bank flight with a coning-type angular vibration of half angle "
+          f"{vib.half_angle_deg}° at {vib.frequency_hz:g} Hz (airframe or engine), sampled "
+          f"at {vib_rate:g} Hz (Ωtd = {2 * math.pi * vib.frequency_hz / vib_rate:.3f}). "
+          "Coning produces a steady drift whose size depends on the algorithm's order; "
+          "the open-loop column is the algorithm alone (ideal gyro, 250 s), the others "
+          "the filter.\n\n")
+    r.add(r.table("vibration_errors", ["filter", "update period", "max roll (°)",
+                                       "max pitch (°)", "max heading (°)",
+                                       "open loop, ideal gyro (°)"], vrows))
+    ols = [float(row[5]) for row in vrows]
+    hs = [float(row[4]) for row in vrows]
+    r.add(f"\nOpen loop the three algorithms drift {ols[0]:.3g}°, {ols[1]:.3g}° and "
+          f"{ols[2]:.3g}° over the flight: here the algorithm matters. The filter bounds "
+          f"the error (accelerometer and magnetometer corrections), leaving max heading "
+          f"errors of {hs[0]:.3g} / {hs[1]:.3g} / {hs[2]:.3g}°; the paper's ordering "
+          f"(3 < 2 < 1) {'holds' if hs[2] < hs[1] < hs[0] else 'does not hold'}.\n")
