@@ -36,27 +36,106 @@ Randomness
 
 Data flows one way: motion → sensor → algorithm (coning correction + update
 structure) → analysis → report.
+
+Layout (imports point only down this list; ``make lint`` enforces it)
+--------------------------------------------------------------------
+``cli``
+    the ``strapdown`` command, one module per command.
+``apps``, ``reproduce``, ``codegen``
+    applications (run a log, compare, sweep, bench, AHRS on logs and BROAD), the paper
+    reproductions, generated C flight code.
+``design``
+    exact coefficient design (sympy) and numerical optimisation.
+``analysis``
+    errors, drift rates and analytic predictions, one configuration evaluated end to end,
+    BROAD's metrics.
+``ahrs``
+    the error-state EKF.
+``algorithms``
+    the algorithm model (:class:`AlgorithmSpec` and its registry), coning sets, update
+    structures, rate-input and quaternion algorithms, cone kinematics, streaming, the
+    arbitrary-precision path, the compiled kernels and their plain-Python twin.
+``truth``, ``io``
+    reference motions, sensor and trajectory models; log readers and file output.
+``rotation``
+    quaternions, rotation vectors, DCMs, Euler and cone angles.
+
+The names below are the recommended entry points; each is imported on first use, so
+``import strapdown`` stays cheap.
 """
 
-from strapdown import analysis, rotation
-from strapdown.algorithms import coning, structures
-from strapdown.algorithms.coning import CoefficientSet, coefficient_set, rotation_vectors
-from strapdown.algorithms.structures import AttitudeSolution, conventional, realtime
-from strapdown.truth import motions, sensors
+from __future__ import annotations
 
-__version__ = "0.1.0"
+import importlib
+from importlib.metadata import PackageNotFoundError, version
 
-__all__ = [
-    "AttitudeSolution",
-    "CoefficientSet",
-    "analysis",
-    "coefficient_set",
-    "coning",
-    "conventional",
-    "motions",
-    "realtime",
-    "rotation",
-    "rotation_vectors",
-    "sensors",
-    "structures",
-]
+try:
+    __version__ = version("strapdown")
+except PackageNotFoundError:  # running from a source tree that is not installed
+    __version__ = "0.0.0+unknown"
+
+#: Public name → module that defines it (imported lazily by :func:`__getattr__`).
+_EXPORTS = {
+    # the algorithm model
+    "AlgorithmSpec": "strapdown.algorithms.spec",
+    "REGISTRY": "strapdown.algorithms.spec",
+    "ALGORITHMS": "strapdown.algorithms.spec",
+    "parse_spec": "strapdown.algorithms.spec",
+    # structures, coning sets, rate algorithms, streaming
+    "AttitudeSolution": "strapdown.algorithms.structures",
+    "conventional": "strapdown.algorithms.structures",
+    "realtime": "strapdown.algorithms.structures",
+    "single_chain": "strapdown.algorithms.structures",
+    "windowed": "strapdown.algorithms.structures",
+    "CoefficientSet": "strapdown.algorithms.coning",
+    "coefficient_set": "strapdown.algorithms.coning",
+    "rotation_vectors": "strapdown.algorithms.coning",
+    "rate_attitude": "strapdown.algorithms.rate",
+    "RotvecStream": "strapdown.algorithms.streaming",
+    # the AHRS
+    "AhrsConfig": "strapdown.ahrs",
+    "ekf": "strapdown.ahrs",
+    # truth
+    "ClassicalConing": "strapdown.truth.motions",
+    "PureSpin": "strapdown.truth.motions",
+    "SpinConing": "strapdown.truth.motions",
+    "KrylovMotion": "strapdown.truth.motions",
+    # analysis
+    "attitude_errors": "strapdown.analysis",
+    "drift_rate": "strapdown.analysis",
+    "evaluate": "strapdown.analysis.evaluate",
+    "EvaluationConfig": "strapdown.analysis.evaluate",
+    # input
+    "read_imu": "strapdown.io",
+}
+#: Subpackages reachable as attributes (``strapdown.rotation``, ``strapdown.motions`` …).
+_MODULES = {
+    "rotation": "strapdown.rotation",
+    "algorithms": "strapdown.algorithms",
+    "analysis": "strapdown.analysis",
+    "ahrs": "strapdown.ahrs",
+    "design": "strapdown.design",
+    "io": "strapdown.io",
+    "truth": "strapdown.truth",
+    "motions": "strapdown.truth.motions",
+    "sensors": "strapdown.truth.sensors",
+    "coning": "strapdown.algorithms.coning",
+    "structures": "strapdown.algorithms.structures",
+}
+
+__all__ = sorted([*_EXPORTS, *_MODULES, "__version__"])
+
+
+def __getattr__(name: str):
+    if name in _EXPORTS:
+        value = getattr(importlib.import_module(_EXPORTS[name]), name)
+    elif name in _MODULES:
+        value = importlib.import_module(_MODULES[name])
+    else:
+        raise AttributeError(f"module 'strapdown' has no attribute {name!r}")
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return __all__
