@@ -1,4 +1,4 @@
-"""Seed 001's three-filter comparison on the loiter flight, and a vibration case.
+"""The three-filter comparison of Wang, Wang & Wang on the loiter flight, and a vibration case.
 
 ``strapdown reproduce wang-sliding --out DIR`` simulates the paper's flight
 (60 s straight east, then a coordinated circle; 250 s) in each consistent
@@ -132,9 +132,10 @@ def _open_loop(sim: Simulation, spec: str, gyro) -> float:
 def reproduce(out: str | Path, *, progress: Callable[[str], None] | None = None) -> Path:
     """Run the study and write it to ``out``; returns the path of ``report.md``."""
     r = Report.begin(out, progress)
-    r.add("# Seed 001 — EKF with three attitude algorithms on the loiter flight\n",
+    r.add("# Wang, Wang & Wang — EKF with three attitude algorithms on the loiter flight\n",
           "Wang, Wang & Wang: multiplicative EKF (attitude error, gyro bias, Singer manoeuvre "
-          "acceleration; papers.md) propagated by algorithm 1 (single-period rotation vector), "
+          "acceleration; our well-posed version of its eqs. 30–35) propagated by algorithm 1 "
+          "(single-period rotation vector), "
           "2 (quaternion RK4) or 3 (sliding three-period rotation vector). Sensors: gyro "
           "0.05 °/s/√Hz with bias (0.2, −0.3, 0.1) °/s, accelerometer 0.02 m/s²/√Hz with "
           "bias, magnetometer 0.5 µT noise, field 50 µT / 60° dip, "
