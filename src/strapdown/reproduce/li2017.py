@@ -166,7 +166,7 @@ def _table2(r: Report) -> float:
     at a = 1°."""
     r.say("Table 2: real-time structure drift in arbitrary precision")
     rows2 = []
-    rt_vs_conv = {60: [], 240: []}
+    rt_vs_conv: dict[int, list[float]] = {60: [], 240: []}
     a_cmp = math.radians(PAPER_HALF_ANGLE_DEG)
     abs_small = []
     for n in NS:

@@ -34,6 +34,7 @@ import numpy as np
 
 from strapdown.ahrs import AhrsConfig, ekf
 from strapdown.algorithms.rate import rate_attitude
+from strapdown.algorithms.spec import parse_spec
 from strapdown.io.report import Report
 from strapdown.rotation.dcm import dcm_from_quat
 from strapdown.rotation.euler import euler_zyx_from_dcm
@@ -55,7 +56,7 @@ PRINTED = {"1: single-period RV": (12.1, 6.3, 37.4), "2: quaternion RK4": (5.4, 
 RATE_HZ = 100.0
 SETTLE_S = 10.0
 GYRO = sensors.GyroErrors(white_noise=math.radians(0.05), bias=np.radians([0.2, -0.3, 0.1]))
-ACC = sensors.AccelerometerErrors(white_noise=0.02, bias=[0.02, -0.01, 0.03])
+ACC = sensors.AccelerometerErrors(white_noise=0.02, bias=np.array([0.02, -0.01, 0.03]))
 MAG = sensors.MagnetometerErrors(white_noise=0.5)
 FIELD = EarthField(50.0, 60.0, 0.0)
 
@@ -118,7 +119,6 @@ def _aided(sim: Simulation, spec: str):
 
 def _open_loop(sim: Simulation, spec: str, gyro) -> float:
     """Max attitude error (rad) of the algorithm alone on the given gyro."""
-    from strapdown.apps.compare import parse_spec
     from strapdown.rotation.error import attitude_error_angle
 
     f = parse_spec(spec)
@@ -180,7 +180,7 @@ def _flight(r: Report) -> tuple[list[list], dict]:
 
 def _flight_verdicts(r: Report, rows: list[list]) -> None:
     """Whether the paper's ordering of the heading errors holds, per reading, and why not."""
-    heads = {}
+    heads: dict[str, list[float]] = {}
     for row in rows:
         if not row[1].startswith("control"):
             heads.setdefault(row[0], []).append(float(row[5]))
