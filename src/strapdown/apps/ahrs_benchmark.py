@@ -32,8 +32,7 @@ import numpy as np
 from strapdown.ahrs import AhrsConfig, ekf
 from strapdown.analysis.broad import broad_errors
 from strapdown.io.broad import BroadTrial, read_broad
-from strapdown.io.files import write_text
-from strapdown.io.report import begin_report
+from strapdown.io.report import Report
 
 __all__ = ["FILTERS", "benchmark", "run_filter"]
 
@@ -116,7 +115,7 @@ def benchmark(directory, out, *, algorithm: str = "rate-single",
     files = sorted(directory.glob("*.mat"))
     if not files:
         raise ValueError(f"{directory}: no BROAD trials (*.mat)")
-    out, w, say, plt, t0 = begin_report(out, progress)
+    rep = Report.begin(out, progress)
     missing = {f: why for f in FILTERS if (why := _available(f))}
     results: dict = {}
     rows = []
@@ -125,7 +124,7 @@ def benchmark(directory, out, *, algorithm: str = "rate-single",
         for f in FILTERS:
             if f in missing:
                 continue
-            say(f"{tr.name}: {f}")
+            rep.say(f"{tr.name}: {f}")
             tic = time.perf_counter()
             q, idx = run_filter(f, tr, algorithm=algorithm)
             sec = time.perf_counter() - tic
@@ -140,7 +139,7 @@ def benchmark(directory, out, *, algorithm: str = "rate-single",
           f"(the rest), degrees. Our propagation: {algorithm}.\n\n"]
     if missing:
         md.append("Not run: " + "; ".join(f"{k} — {v}" for k, v in missing.items()) + "\n\n")
-    md.append(w.table("errors", ["trial", "filter", "total (°)", "heading (°)",
+    md.append(rep.table("errors", ["trial", "filter", "total (°)", "heading (°)",
                                  "inclination (°)", "time (s)"], rows))
     ran = [f for f in FILTERS if f not in missing]
     names = [p.stem for p in files]
@@ -149,7 +148,7 @@ def benchmark(directory, out, *, algorithm: str = "rate-single",
         tot = [results[(n, f)]["total_deg"] for n in names]
         summary.append([f, f"{np.mean(tot):.3f}", f"{min(tot):.3f} … {max(tot):.3f}"])
     md.append("\n## Mean over the trials\n\n")
-    md.append(w.table("summary", ["filter", "mean total RMSE (°)", "range (°)"], summary))
+    md.append(rep.table("summary", ["filter", "mean total RMSE (°)", "range (°)"], summary))
     disturbed = [n for n in names if "disturbed" in n and "undisturbed" not in n]
     if disturbed:
         lines = []
@@ -169,7 +168,7 @@ def benchmark(directory, out, *, algorithm: str = "rate-single",
                   "model takes every sample and needs the gate. The attached magnet disturbs "
                   "the magnetometer for a minute at a time: the norm/dip checks and the heading "
                   "gate keep it out of the heading.\n")
-    fig, ax = plt.subplots(figsize=(9, 4))
+    fig, ax = rep.plt.subplots(figsize=(9, 4))
     width = 0.8 / max(len(ran), 1)
     x = np.arange(len(names))
     for i, f in enumerate(ran):
@@ -180,9 +179,9 @@ def benchmark(directory, out, *, algorithm: str = "rate-single",
     ax.set_title("BROAD trials: total attitude error over movement phases")
     ax.legend(fontsize=8)
     ax.grid(axis="y", alpha=0.3)
-    md.append(f"\n![errors]({w.figure('errors.png', fig)})\n")
-    md.append(f"\nRun time {time.perf_counter() - t0:.0f} s.\n")
-    write_text(out / "report.md", "".join(md))
+    md.append(f"\n![errors]({rep.figure('errors.png', fig)})\n")
+    md.append(f"\nRun time {rep.elapsed():.0f} s.\n")
+    rep.write("".join(md))
     return results
 
 

@@ -26,7 +26,7 @@ import numpy as np
 
 from strapdown.algorithms.spec import AlgorithmSpec, parse_spec
 from strapdown.analysis.evaluate import EvaluationConfig, evaluate
-from strapdown.io.report import begin_report
+from strapdown.io.report import Report
 
 __all__ = ["AlgorithmRun", "compare_log", "compare_motion"]
 
@@ -154,8 +154,8 @@ def compare_log(imu, specs, out, *, kind: str, units: str | None,
 
 
 def _write(out, runs, title, what, progress) -> None:
-    out, writer, say, plt, _ = begin_report(out, progress)
-    fig, ax = plt.subplots(figsize=(8, 4.5))
+    rep = Report.begin(out, progress)
+    fig, ax = rep.plt.subplots(figsize=(8, 4.5))
     for r in runs:
         if r.angle.size and np.any(r.angle > 0):
             ax.semilogy(r.t, np.where(r.angle > 0, r.angle, np.nan), lw=0.8, label=r.label)
@@ -166,7 +166,7 @@ def _write(out, runs, title, what, progress) -> None:
     ax.set_title(f"{title}\n{what}", fontsize=9)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
-    writer.figure("error_vs_time.png", fig)
+    rep.figure("error_vs_time.png", fig)
     header = list(runs[0].summary)
     for r in runs[1:]:
         header += [k for k in r.summary if k not in header]
@@ -177,5 +177,5 @@ def _write(out, runs, title, what, progress) -> None:
         return f"{v:.6e}" if isinstance(v, float) else v
 
     rows = [[cell(r.summary.get(k)) for k in header] for r in runs]
-    writer.table("summary", header, rows)
-    say(f"wrote {out}/summary.md, summary.csv, error_vs_time.png ({what})")
+    rep.table("summary", header, rows)
+    rep.say(f"wrote {rep.out}/summary.md, summary.csv, error_vs_time.png ({what})")

@@ -112,11 +112,3 @@ class Report:
         """Write ``report.md`` (atomically); returns its path."""
         return write_text(self.out / "report.md", text)
 
-
-def begin_report(out: str | Path, progress: Callable[[str], None] | None):
-    """Start a report (tuple form of :meth:`Report.begin`, used by the apps).
-
-    Returns ``(out, writer, say, plt, t_start)``.
-    """
-    r = Report.begin(out, progress)
-    return r.out, r.writer, r.say, r.plt, r.t_start
