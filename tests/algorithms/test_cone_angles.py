@@ -127,7 +127,7 @@ def test_kernel_matches_reference(method):
     assert a.switches == b.switches
 
 
-def test_paper_formulas_fail_where_papers_md_says():
+def test_paper_formulas_fail_where_the_errata_say():
     rng = np.random.default_rng(3)
     d1, d3 = rng.uniform(0, 2 * np.pi, (2, 200))
     d2 = rng.uniform(0.1, np.pi - 0.1, 200)

@@ -94,7 +94,7 @@ def test_mp_closed_forms_agree_with_float64():
 
 
 def test_rotation_sequence_motion_reproduces_coning():
-    # Classical coning as x–z–x cone angles (papers.md seed 004): δ1 = Ωt − π/2, δ2 = a, δ3 = 0,
+    # Classical coning as x–z–x cone angles (Zhang & Yu (2021)): δ1 = Ωt − π/2, δ2 = a, δ3 = 0,
     # C = Rx(δ1) Rz(δ2) Rx(δ3 − δ1).
     a, om = 0.3, 2.0
     seq = M.RotationSequenceMotion(

@@ -1,4 +1,4 @@
-"""Attitude integration for flight control in cone angles (Zhang & Yu 2021; papers.md).
+"""Attitude integration for flight control in cone angles (Zhang & Yu (2021)).
 
 From gyro rate samples, integrated by classical RK4 with step 2·td (the
 middle rate is the middle sample, as :mod:`strapdown.algorithms.rate` documents):

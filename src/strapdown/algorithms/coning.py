@@ -9,7 +9,8 @@ with an upper-triangular coefficient matrix ``K`` (``K[i, j]`` multiplies
 
 ``table3``
     Li & Zhang 2017 Table 3 read as "cross with the last subsample"
-    (papers.md): ``φ = Σθ + Σ_{m=1}^{N−1} ς_m θ_{N−m} × θ_N``. The
+    (Li & Zhang (2017) print eq. 6 over all pairs):
+    ``φ = Σθ + Σ_{m=1}^{N−1} ς_m θ_{N−m} × θ_N``. The
     classical-coning optimum; drift constant N!(N+1)!/(2N+2)!.
 ``lag``
     The same lag sums ``K_m = ς_m`` spread evenly over all ``N − m`` pairs of
@@ -129,7 +130,7 @@ def _table3(n):
     k = _zeros(n)
     for m, s in enumerate(TABLE3[n], start=1):
         k[n - 1 - m][n - 1] = s
-    return _from_exact("table3", k, "Li & Zhang 2017 Table 3, cross-with-last (papers.md)", True)
+    return _from_exact("table3", k, "Li & Zhang 2017 Table 3, cross-with-last", True)
 
 
 def _lag(n):

@@ -1,29 +1,30 @@
-"""Angular-rate-input attitude algorithms (Wang, Wang & Wang; seed 001, papers.md).
+"""Angular-rate-input attitude algorithms (Wang, Wang & Wang; see docs/references.md).
 
 Many MEMS gyros output rates, not increments. On uniformly spaced rate
 samples ``ω_k`` at ``t_k = t_0 + k·td``:
 
 ``rate-single``
     Single-period rotation vector, ``ΔΦ = td/2 (ω_{k−1} + ω_k) + c td² ω_{k−1} × ω_k``.
-    ``paper``: c = 1/12 (the seed's start-up form) — truly second order under
+    ``paper``: c = 1/12 (the paper's start-up form) — truly second order under
     coning, no better than c = 0; ``derived``: c = 1/6 (designer, quadrature
     error included) — fourth order.
 ``rate-three``
     Three-period algorithm: ω1…ω4 at 0, T/3, 2T/3, T (T = 3 td), cubic fit
     ⇒ α = T/8 (ω1 + 3ω2 + 3ω3 + ω4), β = td² Σ_{i<j} k_ij ω_i × ω_j with lag
     sums split evenly. ``paper``: lag sums fitted to the coning term alone
-    (seed eqs. 14–16 as reconstructed) — claims (Ωtd)^8, is (Ωtd)^4;
+    (the paper's eqs. 14–16 as reconstructed) — claims (Ωtd)^8, is (Ωtd)^4;
     ``derived``: the designer with the quadrature error — truly (Ωtd)^8.
     Structures: ``conventional`` (an update every 3 td) and ``sliding``
-    (seed eqs. 20–29: Q(t1), Q(t2) by single-period steps, then
+    (the paper's eqs. 20–29: Q(t1), Q(t2) by single-period steps, then
     ``Q(t_k) = Q(t_{k−3}) ⊗ q(ΔΦ[t_{k−3}, t_k])`` every td — three interleaved
     three-period chains).
 ``rk4``
     Quaternion 4th-order Runge–Kutta on ``q̇ = ½ q ⊗ ω``, normalised after
-    each step. ``rk4_step="2td"`` (default, the seed's baseline: step 2 td,
+    each step. ``rk4_step="2td"`` (default, the paper's baseline: step 2 td,
     middle rate = the middle sample) is fourth order, drift +a²Ω(Ωtd)⁴/60;
     ``"td-interp"`` (step td, middle rate = mean of the ends) is second order,
-    drift −a²Ω(Ωtd)²/12 (both derived in :func:`strapdown.design.rk4_classical_coning_drift`).
+    drift −a²Ω(Ωtd)²/12 (both derived in
+    :func:`strapdown.design.rk4_classical_coning_drift`).
 """
 
 from __future__ import annotations

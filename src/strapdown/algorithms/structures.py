@@ -14,7 +14,8 @@
     when the family has no k-subsample member).
 
     The structure is N interleaved conventional chains that never exchange
-    information (papers.md): it raises the output rate, not the accuracy.
+    information (contrary to Li & Zhang (2017), Table 2): it raises the output rate, not
+    the accuracy.
     :attr:`AttitudeSolution.chain` tells which chain produced each output.
 """
 

@@ -195,7 +195,7 @@ def table1_prediction(half_angle: float, cone_rate: float, h: float, n: int) -> 
     """Table 1 drift about the cone axis (rad/s): ``−c_N a² Ω (Ωh)^{2N}``.
 
     Leading order in the half-cone angle ``a`` for the optimal N-subsample set
-    (Li & Zhang 2017 Table 1; ``c_N = N!(N+1)!/(2N+2)!``, papers.md). The sign
+    (Li & Zhang 2017 Table 1; ``c_N = N!(N+1)!/(2N+2)!``). The sign
     is negative: the computed attitude drifts against the cone rotation.
     """
     h = positive(h, "h")

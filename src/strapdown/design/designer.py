@@ -31,7 +31,8 @@ and is a power series in ``x`` with rational coefficients. For increment
 input the increments tile the update exactly, ``ε_c = 0`` and ``D`` is the
 familiar lag-sum series; for rate input the quadrature error of ``α`` enters
 through ``ε_c`` at the same order as the coning term, which is why a
-derivation that ignores it overstates the order (papers.md, seed 001).
+derivation that ignores it overstates the order (as Wang, Wang & Wang's three-period
+derivation does; see docs/reproductions.md).
 
 The drift about the cone axis is ``D / T_update``; we report it in the sign
 convention of Li & Zhang Table 1: drift = −c · a²Ω(Ωh)^order, so that a

@@ -10,7 +10,8 @@ simulation against any reference motion and metric, reproducibly:
   seeded (scipy ``differential_evolution`` with ``seed``, ``workers=1``,
   ``polish=True``).
 
-Optimising to one motion overfits (papers.md, seed 003); :func:`transfer`
+Optimising to one motion overfits (Plaksiy (2024)'s optimised sets do; see
+docs/reproductions.md); :func:`transfer`
 evaluates optimised sets on other motions, step sizes and cone angles.
 """
 

@@ -1,4 +1,4 @@
-"""Cone angles of the double-rotation representation (Zhang & Yu 2021; papers.md, seed 004).
+"""Cone angles of the double-rotation representation (Zhang & Yu (2021)).
 
 ``C_c_b = Rx(δ1) Rz(δ2) Rx(δ3 − δ1)`` (active rotations; c = the cone frame, our
 ``n``): δ1 precession, δ2 nutation (the half-cone angle), δ3 roll measured

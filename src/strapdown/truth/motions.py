@@ -450,7 +450,7 @@ def _int_cos(m: Backend, lams, t0, dt):
 
 
 class ConeAngleMotion(Motion):
-    """A motion given by cone angles δ1(t), δ2(t), δ3(t) (Zhang & Yu 2021, papers.md).
+    """A motion given by cone angles δ1(t), δ2(t), δ3(t) (Zhang & Yu (2021)).
 
     ``q_c_b = q_x(δ1) ⊗ q_z(δ2) ⊗ q_x(δ3 − δ1)``; body rates from eq. 6 (exact);
     increments by Gauss–Legendre quadrature. Classical coning is

@@ -199,7 +199,7 @@ def preaveraged_increments(motion: Motion, h: float, n: int, m: int, *, t0: floa
     Raw rates are taken at the midpoints of the ``m`` sub-intervals of each
     ``h`` and corrupted at their own interval ``h/m``; the processed rate is
     their **mean** (eq. 11 prints a division by ``h``, which is dimensionally
-    wrong; papers.md), and the increment is ``h`` times it.
+    wrong; Li & Zhang (2017)), and the increment is ``h`` times it.
     """
     h, n, edges = _edges(h, n, t0)
     m = positive_int(m, "m (raw samples per interval)")

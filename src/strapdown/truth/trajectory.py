@@ -13,9 +13,9 @@ z up). Attitude ``C_n_b = Rz(ψ) Ry(−θ) Rx(φ)`` with heading ``ψ``
 counter-clockwise from east, pitch ``θ`` nose up (0 here) and bank ``φ``
 positive right wing down; a right turn (ψ decreasing) has positive bank.
 
-:func:`wang_circle` builds seed 001's scenario (60 s straight east, then a
+:func:`wang_circle` builds Wang, Wang & Wang's scenario (60 s straight east, then a
 circle, 250 s in all) in one of its three consistent readings — the paper's
-600 m radius, 20 m/s and 20° bank cannot hold together (papers.md):
+600 m radius, 20 m/s and 20° bank cannot hold together:
 
 - ``"speed-radius"``: 20 m/s on 600 m ⇒ bank 3.90°;
 - ``"speed-bank"``: 20 m/s at 20° ⇒ radius 112.0 m;
