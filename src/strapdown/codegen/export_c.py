@@ -208,19 +208,27 @@ unsigned long {name}_state_size(void) {{ return (unsigned long)sizeof({name}_sta
 
 
 def _gen_rotvec(spec, real, h):
-    from strapdown.algorithms.structures import single_chain_coefficients, startup_sets
-
-    n, structure, coefficients = spec.subsamples, spec.structure, spec.coefficients
-    if structure == "single-chain":
-        if coefficients not in (None, "table3"):
+    if spec.structure == "single-chain":
+        if spec.coefficients not in (None, "table3"):
             raise ValueError("the single chain exports its designed coefficients only")
-        rows = [list(single_chain_coefficients(m + 1)) for m in range(n)]
-        width = max(n - 1, 1)
-        table = ",\n".join("    {" + ", ".join(
-            [f"{_lit(c, real)} /* {_frac(c)} */" for c in r]
-            + [_lit(0, real)] * (width - len(r))) + "}" for r in rows)
-        struct = f"    real_t q[4];\n    real_t q0[4];\n    real_t hist[{width}][3];\n    long k;"
-        body = f"""
+        return _gen_single_chain(spec.subsamples, real)
+    cs = coefficient_set(spec.coefficients or "table3", spec.subsamples)
+    if spec.structure == "conventional":
+        return _gen_conventional(cs, real)
+    return _gen_realtime(cs, real)
+
+
+def _gen_single_chain(n, real):
+    """Single chain: one update per increment, cross products with the previous N − 1."""
+    from strapdown.algorithms.structures import single_chain_coefficients
+
+    rows = [list(single_chain_coefficients(m + 1)) for m in range(n)]
+    width = max(n - 1, 1)
+    table = ",\n".join("    {" + ", ".join(
+        [f"{_lit(c, real)} /* {_frac(c)} */" for c in r]
+        + [_lit(0, real)] * (width - len(r))) + "}" for r in rows)
+    struct = f"    real_t q[4];\n    real_t q0[4];\n    real_t hist[{width}][3];\n    long k;"
+    body = f"""
 static const real_t SC[{n}][{width}] = {{
 {table}
 }};
@@ -243,15 +251,18 @@ int NAME_update(NAME_state *s, const real_t th[3], real_t q_out[4])
     return 1;
 }}
 """
-        ops = _add_ops(_times(_CROSS_OPS, n - 1), _UPDATE_OPS)
-        return struct, body, ops, f"single-chain rotation vector, N = {n}, update every h"
-    cs = coefficient_set(coefficients or "table3", n)
+    ops = _add_ops(_times(_CROSS_OPS, n - 1), _UPDATE_OPS)
+    return struct, body, ops, f"single-chain rotation vector, N = {n}, update every h"
+
+
+def _gen_conventional(cs, real):
+    """Conventional structure: an update every N increments."""
+    n = cs.n
     k = cs.exact if cs.exact is not None else cs.matrix.tolist()
     terms = _rotvec_terms(k)
-    if structure == "conventional":
-        struct = f"    real_t q[4];\n    real_t q0[4];\n    real_t th[{n}][3];\n    int count;"
-        phi = _phi_rotvec(terms, "s->th", lambda i: str(i), n, real)
-        body = f"""{_init_reset("q", "count")}
+    struct = f"    real_t q[4];\n    real_t q0[4];\n    real_t th[{n}][3];\n    int count;"
+    phi = _phi_rotvec(terms, "s->th", lambda i: str(i), n, real)
+    body = f"""{_init_reset("q", "count")}
 
 int NAME_update(NAME_state *s, const real_t sample[3], real_t q_out[4])
 {{
@@ -267,10 +278,17 @@ int NAME_update(NAME_state *s, const real_t sample[3], real_t q_out[4])
     return 1;
 }}
 """
-        ops = _add_ops({"add": 3 * n}, _times(_CROSS_OPS, len(terms)), _UPDATE_OPS)
-        return struct, body, ops, (f"rotation vector, N = {n}, coefficients {cs.name}, "
-                                   "conventional structure (update every N h)")
-    # real-time: ring of the last N increments and N attitudes
+    ops = _add_ops({"add": 3 * n}, _times(_CROSS_OPS, len(terms)), _UPDATE_OPS)
+    return struct, body, ops, (f"rotation vector, N = {n}, coefficients {cs.name}, "
+                               "conventional structure (update every N h)")
+
+
+def _gen_realtime(cs, real):
+    """Real-time structure: a ring of the last N increments and N attitudes."""
+    from strapdown.algorithms.structures import startup_sets
+
+    n = cs.n
+    terms = _rotvec_terms(cs.exact if cs.exact is not None else cs.matrix.tolist())
     sets = startup_sets(cs)
     starts = []
     for m, st in enumerate(sets[:-1], start=1):
