@@ -8,15 +8,34 @@ import tempfile
 from pathlib import Path
 
 
+def _umask() -> int:
+    """The process umask (read without changing it for other threads where the OS allows)."""
+    try:  # Linux: /proc/self/status has a Umask line
+        with open("/proc/self/status", encoding="ascii") as f:
+            for line in f:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError):
+        pass
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
 @contextlib.contextmanager
 def atomic_path(path: str | os.PathLike):
-    """Yield a temporary path in the target's directory; rename it over ``path`` on success."""
+    """Yield a temporary path in the target's directory; rename it over ``path`` on success.
+
+    The file gets the mode a plain ``open(path, "w")`` would give it (0666 less the
+    umask), not the 0600 of the private temporary file.
+    """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=path.suffix, dir=path.parent)
     os.close(fd)
     try:
         yield Path(tmp)
+        os.chmod(tmp, 0o666 & ~_umask())
         os.replace(tmp, path)
     except BaseException:
         with contextlib.suppress(FileNotFoundError):
