@@ -1,0 +1,251 @@
+"""What the subcommands share: the parser classes, help formatting and argument groups.
+
+Nothing here imports numpy or the algorithm registry at module level. A subcommand's
+options are added by a function given to :class:`CommandParser`, which runs only when that
+subcommand is parsed or its help is shown, so ``strapdown --version`` and
+``strapdown --help`` never build the option lists (nor import what their choices come from).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from collections.abc import Callable, Iterable
+from typing import TYPE_CHECKING, TypeVar
+
+if TYPE_CHECKING:
+    from strapdown.algorithms.family import Family
+
+__all__ = [
+    "INCREMENT_UNITS",
+    "RATE_UNITS",
+    "CommandParser",
+    "HelpFormatter",
+    "Parser",
+    "algorithm_help",
+    "coefficients_help",
+    "columns",
+    "json_arg",
+    "log_args",
+    "log_check_args",
+    "motion_args",
+    "print_json",
+    "progress",
+    "progress_args",
+    "say",
+    "structure_help",
+]
+
+#: Units of a rate log and of an increment log (what :func:`strapdown.io.read_imu` accepts).
+RATE_UNITS = ("rad/s", "deg/s")
+INCREMENT_UNITS = ("rad", "deg")
+
+#: Where options go: a parser or one of its argument groups.
+Options = argparse.ArgumentParser | argparse._ArgumentGroup
+_K = TypeVar("_K")
+
+
+class HelpFormatter(argparse.HelpFormatter):
+    """Appends ``(default: …)`` to an option's help when it has a default worth showing.
+
+    Not for flags (``store_true``), options defaulting to ``None`` and help that already
+    states its default; a sequence default is shown space-separated, as it is typed.
+    """
+
+    def _get_help_string(self, action: argparse.Action) -> str:
+        text = action.help or ""
+        default = action.default
+        if (not action.option_strings or default is None or default is argparse.SUPPRESS
+                or isinstance(action, argparse._StoreConstAction) or "default" in text):
+            return text
+        if isinstance(default, (list, tuple)):
+            default = " ".join(str(v) for v in default)
+        return f"{text} (default: {str(default).replace('%', '%%')})"
+
+
+class Parser(argparse.ArgumentParser):
+    """The command line's parser: no abbreviated options, defaults shown in help."""
+
+    def __init__(self, *args, **kwargs) -> None:
+        kwargs.setdefault("allow_abbrev", False)
+        kwargs.setdefault("formatter_class", HelpFormatter)
+        super().__init__(*args, **kwargs)
+
+
+class CommandParser(Parser):
+    """A subcommand's parser that adds its options on first use.
+
+    Parameters
+    ----------
+    arguments : callable, optional
+        ``arguments(parser)`` adds the options; it runs once, before the first parse or
+        help text, so the imports its choice lists need happen only for that subcommand.
+    """
+
+    def __init__(self, *args, arguments: Callable[[Parser], None] | None = None,
+                 **kwargs) -> None:
+        super().__init__(*args, **kwargs)
+        self._arguments = arguments
+
+    def add_arguments(self) -> CommandParser:
+        """Add the options now if not yet added (idempotent); returns the parser."""
+        if self._arguments is not None:
+            add, self._arguments = self._arguments, None
+            add(self)
+        return self
+
+    def parse_known_args(self, args=None, namespace=None):
+        self.add_arguments()
+        return super().parse_known_args(args, namespace)
+
+    def format_usage(self) -> str:
+        self.add_arguments()
+        return super().format_usage()
+
+    def format_help(self) -> str:
+        self.add_arguments()
+        return super().format_help()
+
+
+# ------------------------------------------------------------------------------ output
+def say(msg: str) -> None:
+    """One line on stderr (progress and warnings; stdout carries the results)."""
+    print(msg, file=sys.stderr)
+
+
+def print_json(record: dict) -> None:
+    """``record`` as indented JSON on stdout (non-ASCII kept)."""
+    print(json.dumps(record, indent=2, ensure_ascii=False))
+
+
+def json_arg(p: argparse.ArgumentParser) -> None:
+    """``--json``: machine-readable output."""
+    p.add_argument("--json", action="store_true",
+                   help="print one JSON object instead of the human-readable text")
+
+
+def columns(text: str) -> tuple[str, ...]:
+    """``"t, gx,gy"`` → ``("t", "gx", "gy")``."""
+    return tuple(c.strip() for c in text.split(","))
+
+
+# ------------------------------------------------------------------------------ groups
+def motion_args(p: argparse.ArgumentParser, rate_default: float | None = 10_000.0) -> None:
+    """The reference motion and its ideal gyro: ``--motion`` … ``--duration``.
+
+    ``rate_default=None`` (``compare``) leaves ``--sample-rate-hz`` unset so a log's own
+    rate applies; motions then run at 10000 Hz.
+    """
+    from strapdown.analysis.evaluate import MOTIONS
+
+    g = p.add_argument_group("motion")
+    g.add_argument("--motion", choices=MOTIONS, default="coning",
+                   help="reference motion: classical coning, pure spin, spin with coning, or "
+                   "Plaksiy's Krylov-angle model")
+    g.add_argument("--krylov-rates", type=float, nargs=3, metavar=("K1", "K2", "K3"),
+                   default=(0.15, 0.25, 0.05),
+                   help="krylov motion: angle rates (rad/s), angles k_i·t (Plaksiy)")
+    g.add_argument("--half-angle-deg", type=float, default=1.0, help="half cone angle (deg)")
+    g.add_argument("--cone-rate-hz", type=float, default=1.0, help="cone frequency Ω/2π (Hz)")
+    g.add_argument("--spin-rate-dps", type=float, default=0.0, help="spin rate (deg/s)")
+    rate_help = "gyro increment rate 1/h (Hz)"
+    if rate_default is None:
+        rate_help += "; motions default to 10000, a log to its own time stamps"
+    g.add_argument("--sample-rate-hz", type=float, default=rate_default, help=rate_help)
+    g.add_argument("--duration", type=float, default=2.0, help="simulated time (s)")
+
+
+def log_args(p: argparse.ArgumentParser, *, imu_help: str, required: bool,
+             sample_rate: bool) -> None:
+    """A gyro log: ``--imu``, ``--rates``/``--increments``, ``--units``, ``--columns`` and,
+    with ``sample_rate``, ``--sample-rate-hz``.
+
+    ``required`` makes ``--imu`` and the kind mandatory (``run``); otherwise the log is
+    optional (``compare`` runs on a motion without one, and its ``--sample-rate-hz`` is the
+    motion's, see :func:`motion_args`).
+    """
+    g = p.add_argument_group("gyro log")
+    g.add_argument("--imu", required=required, help=imu_help)
+    kind = g.add_mutually_exclusive_group(required=required)
+    kind.add_argument("--rates", dest="kind", action="store_const", const="rate",
+                      help="the log holds angular rates")
+    kind.add_argument("--increments", dest="kind", action="store_const", const="increment",
+                      help="the log holds angular increments")
+    g.add_argument("--units", default=None, choices=(*RATE_UNITS, *INCREMENT_UNITS),
+                   help=f"rates: {' or '.join(RATE_UNITS)}; increments: "
+                   f"{' or '.join(INCREMENT_UNITS)} (required unless the CSV header declares "
+                   "it, e.g. gx[deg/s])")
+    g.add_argument("--columns", default="t,gx,gy,gz",
+                   help="CSV columns for time and the three axes, comma-separated")
+    if sample_rate:
+        g.add_argument("--sample-rate-hz", type=float, default=None,
+                       help="sample rate (Hz) of a log without time stamps or a stated rate "
+                       "(.mat, HDF5)")
+
+
+def log_check_args(p: argparse.ArgumentParser) -> None:
+    """What to do about a log's faults: ``--on-gap``, ``--gap-tolerance``, ``--saturation``."""
+    g = p.add_argument_group("log checks")
+    g.add_argument("--on-gap", choices=["report", "error", "split"], default="report",
+                   help="gaps (intervals over --gap-tolerance samples): report them, fail, or "
+                   "run each gap-free segment separately")
+    g.add_argument("--gap-tolerance", type=float, default=1.5,
+                   help="gap threshold in median sample intervals")
+    g.add_argument("--saturation", type=float, default=None,
+                   help="sensor range in the declared unit; saturated rows are reported")
+
+
+def progress_args(p: Options) -> None:
+    """``--progress`` / ``--no-progress``; neither: a bar when stderr is a terminal."""
+    prog = p.add_mutually_exclusive_group()
+    prog.add_argument("--progress", dest="progress", action="store_true", default=None,
+                      help="progress bar on stderr (default: when stderr is a terminal)")
+    prog.add_argument("--no-progress", dest="progress", action="store_false",
+                      help="no progress bar")
+
+
+def progress(args: argparse.Namespace) -> bool:
+    """Whether to show a progress bar (see :func:`progress_args`)."""
+    return sys.stderr.isatty() if args.progress is None else args.progress
+
+
+# ------------------------------------------------------------------------------ registry help
+def _by_family(names: Iterable[str], key: Callable[[Family], _K]) -> list[tuple[str, _K]]:
+    """``[("a, b", value), …]``: the families among ``names`` grouped by ``key(family)``."""
+    from strapdown.algorithms.spec import REGISTRY
+
+    groups: dict[_K, list[str]] = {}
+    for n in names:
+        groups.setdefault(key(REGISTRY[n]), []).append(n)
+    return [(", ".join(ns), value) for value, ns in groups.items()]
+
+
+def algorithm_help(names: Iterable[str]) -> str:
+    """What each of ``names`` (registered families) takes as input."""
+    def kind(f: Family) -> str:
+        if f.stepped:
+            return "whole computation steps (--step) of sub-step increments"
+        return "increments" if f.input_kind == "increment" else "rate samples"
+
+    return "; ".join(f"{ns}: {what}" for ns, what in _by_family(names, kind))
+
+
+def coefficients_help(names: Iterable[str]) -> str:
+    """The coefficient sets each of ``names`` takes, its default first."""
+    def sets(f: Family) -> tuple[tuple[str, ...], str | None]:
+        return tuple(f.coefficient_names()), f.default_coefficients
+
+    parts = []
+    for ns, (choices, default) in _by_family(names, sets):
+        rest = [c for c in choices if c != default]
+        parts.append(f"{ns}: " + (f"{default} (default), {', '.join(rest)}" if choices
+                                  else "none"))
+    return "; ".join(parts)
+
+
+def structure_help(names: Iterable[str]) -> str:
+    """The update structures each of ``names`` runs in, its default first."""
+    groups = _by_family(names, lambda f: f.structures)
+    return ("update structure; " + "; ".join(f"{ns}: {', '.join(st)}" for ns, st in groups)
+            + " (single-chain: an attitude every h; sliding: every td)")

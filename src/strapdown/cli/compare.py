@@ -1,0 +1,64 @@
+"""``strapdown compare``: several algorithms on one reference motion or one gyro log."""
+
+from __future__ import annotations
+
+import argparse
+
+from strapdown.cli._common import columns, log_args, motion_args, say
+
+__all__ = ["add_parser", "run"]
+
+
+def add_parser(subparsers) -> argparse.ArgumentParser:
+    """Register ``compare`` (its options are added when it is used)."""
+    p = subparsers.add_parser(
+        "compare", arguments=_arguments,
+        help="several algorithms on one motion or one log",
+        description="Run several algorithms on one reference motion (errors against exact "
+        "truth) or on one gyro log (against --truth, or else relative to the first spec); "
+        "write error_vs_time.png and summary.md/.csv.")
+    p.set_defaults(handler=run)
+    return p
+
+
+def _arguments(p: argparse.ArgumentParser) -> None:
+    from strapdown.algorithms.spec import ALGORITHMS, SPEC_KEYS
+
+    p.add_argument("--algorithms", nargs="+", required=True, metavar="SPEC",
+                   help="algorithm specs, e.g. rotvec:N=3 rotvec:N=3:structure=realtime "
+                   f"rate-three:structure=sliding rk4 (algorithms: {', '.join(ALGORITHMS)}; "
+                   f"keys: N, {', '.join(k for k in SPEC_KEYS if k != 'subsamples')})")
+    motion_args(p, rate_default=None)
+    log_args(p, imu_help="compare on this log instead of a motion", required=False,
+             sample_rate=False)
+    p.add_argument("--truth", default=None,
+                   help="log only: reference attitude file with t,qw,qx,qy,qz (CSV or .npz)")
+    p.add_argument("--out", required=True, help="output directory")
+
+
+def run(args: argparse.Namespace) -> int:
+    """Compare the specs and print each one's maximum and RMS error."""
+    from strapdown.apps import compare
+
+    if args.imu is None:
+        if args.kind or args.truth or args.units:
+            raise ValueError("--rates/--increments, --units and --truth belong to --imu")
+        from strapdown.analysis.evaluate import EvaluationConfig
+
+        base = EvaluationConfig(
+            motion=args.motion, half_angle_deg=args.half_angle_deg,
+            cone_rate_hz=args.cone_rate_hz, spin_rate_dps=args.spin_rate_dps,
+            sample_rate_hz=args.sample_rate_hz or 10_000.0, duration=args.duration,
+            krylov_rates=tuple(args.krylov_rates))
+        runs = compare.compare_motion(base, args.algorithms, args.out, progress=say)
+    else:
+        if args.kind is None:
+            raise ValueError("--imu needs --rates or --increments")
+        runs = compare.compare_log(args.imu, args.algorithms, args.out, kind=args.kind,
+                                   units=args.units, columns=columns(args.columns),
+                                   sample_rate_hz=args.sample_rate_hz, truth=args.truth,
+                                   progress=say)
+    for r in runs:
+        print(f"{r.label:40s} max {r.summary['max_error_rad']:.3e} rad  "
+              f"rms {r.summary['rms_error_rad']:.3e} rad")
+    return 0

@@ -1,0 +1,54 @@
+"""``strapdown sweep``: a TOML scenario's parameter grid, resumable."""
+
+from __future__ import annotations
+
+import argparse
+
+from strapdown.cli._common import progress, progress_args, say
+
+__all__ = ["INCOMPLETE", "add_parser", "run"]
+
+#: Exit status of a sweep stopped (``--max-cases``) before its grid is complete.
+INCOMPLETE = 3
+
+
+def add_parser(subparsers) -> argparse.ArgumentParser:
+    """Register ``sweep`` (its options are added when it is used)."""
+    p = subparsers.add_parser(
+        "sweep", arguments=_arguments,
+        help="run a TOML scenario's parameter grid (resumable)",
+        description="Run every case of a scenario file's grid; each finished case is saved at "
+        "once, so an interrupted sweep resumes where it stopped. Writes OUT/results.csv and "
+        "OUT/results.parquet when the grid is complete. Exits with status "
+        f"{INCOMPLETE} when --max-cases stops it first.")
+    p.set_defaults(handler=run)
+    return p
+
+
+def _arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("scenario", help="scenario file (.toml); see strapdown.apps.sweep")
+    p.add_argument("--out", required=True, help="output directory")
+    p.add_argument("--scheduler", default="local",
+                   help="local (process pool) or dask://HOST:PORT")
+    p.add_argument("--workers", type=int, default=None,
+                   help="local pool size (default: CPU count; 1 runs in this process)")
+    p.add_argument("--format", default="csv,parquet",
+                   help="table formats, comma-separated: csv, parquet")
+    p.add_argument("--max-cases", type=int, default=None,
+                   help="compute at most this many new cases, then stop")
+    progress_args(p)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run (or finish) the grid; exit status :data:`INCOMPLETE` if cases remain."""
+    from strapdown.apps.sweep import sweep
+
+    res = sweep(args.scenario, args.out, scheduler=args.scheduler, workers=args.workers,
+                formats=[f.strip() for f in args.format.split(",") if f.strip()],
+                max_cases=args.max_cases, progress=progress(args), log=say)
+    if not res.complete:
+        print(f"{res.skipped + res.computed} of {res.total} cases done; rerun to finish")
+        return INCOMPLETE
+    print(f"wrote {res.csv}" + (f" and {res.parquet}" if res.parquet else "")
+          + f" ({res.total} cases, {res.skipped} reused)")
+    return 0
