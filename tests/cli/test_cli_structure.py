@@ -26,7 +26,7 @@ def _subcommands(parser: argparse.ArgumentParser) -> dict[str, argparse.Argument
 
 
 def _subparser(name: str) -> argparse.ArgumentParser:
-    return _subcommands(build_parser())[name].add_arguments()
+    return _subcommands(build_parser())[name].populate()
 
 
 def _option(name: str, flag: str) -> argparse.Action:

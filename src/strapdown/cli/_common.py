@@ -88,7 +88,7 @@ class CommandParser(Parser):
         super().__init__(*args, **kwargs)
         self._arguments = arguments
 
-    def add_arguments(self) -> CommandParser:
+    def populate(self) -> CommandParser:
         """Add the options now if not yet added (idempotent); returns the parser."""
         if self._arguments is not None:
             add, self._arguments = self._arguments, None
@@ -96,15 +96,15 @@ class CommandParser(Parser):
         return self
 
     def parse_known_args(self, args=None, namespace=None):
-        self.add_arguments()
+        self.populate()
         return super().parse_known_args(args, namespace)
 
     def format_usage(self) -> str:
-        self.add_arguments()
+        self.populate()
         return super().format_usage()
 
     def format_help(self) -> str:
-        self.add_arguments()
+        self.populate()
         return super().format_help()
 
 
