@@ -17,14 +17,13 @@ accelerometer and magnetometer updates at every output) runs on
 
 from __future__ import annotations
 
-import json
 import subprocess
 import sys
 import time
 
 import numpy as np
 
-__all__ = ["main", "run_benchmarks"]
+__all__ = ["run_benchmarks"]
 
 
 def _best(fn, repeat):
@@ -220,35 +219,3 @@ def run_benchmarks(samples: int = 10_000_000, peer_samples: int = 20_000, repeat
             recs.append(_stream_memory(stream_samples, structure))
     return recs
 
-
-def main(argv=None) -> int:
-    import argparse
-
-    p = argparse.ArgumentParser(prog="strapdown bench", description=__doc__, allow_abbrev=False)
-    p.add_argument("--samples", type=int, default=10_000_000)
-    p.add_argument("--peer-samples", type=int, default=20_000)
-    p.add_argument("--stream-samples", type=int, default=100_000_000,
-                   help="0 skips the streaming memory test")
-    p.add_argument("--ekf-samples", type=int, default=1_000_000,
-                   help="samples for the AHRS EKF and its peers (0 skips them)")
-    p.add_argument("--repeat", type=int, default=3)
-    p.add_argument("--json", action="store_true")
-    a = p.parse_args(argv)
-    recs = run_benchmarks(a.samples, a.peer_samples, a.repeat, a.stream_samples, a.ekf_samples)
-    if a.json:
-        print(json.dumps(recs, indent=2))
-        return 0
-    print(f"{'name':34s} {'samples/s':>12s} {'× numpy pass':>13s}  peer")
-    for r in recs:
-        if "peak_rss_mb" in r:
-            print(f"{r['name']:34s} peak RSS {r['peak_rss_mb']:.0f} MB in {r['seconds']:.0f} s")
-        elif r["samples_per_s"] is None:
-            print(f"{r['name']:34s} failed: {r['error']}")
-        else:
-            print(f"{r['name']:34s} {r['samples_per_s']:12.3e} {r['ratio_to_numpy_pass']:13.4f}"
-                  f"  {r['peer'] or ''}")
-    return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())

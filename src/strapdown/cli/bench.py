@@ -1,6 +1,6 @@
 """``strapdown bench``: throughput benchmarks, as ratios to a NumPy pass and against peers.
 
-An ordinary subcommand with the options of :func:`strapdown.apps.bench.main`; the numbers
+An ordinary subcommand over :func:`strapdown.apps.bench.run_benchmarks`; the numbers
 are reported, never asserted.
 """
 
