@@ -177,13 +177,16 @@ def rotation_matrices(shape=None) -> st.SearchStrategy[np.ndarray]:
 def increments(rows, *, max_abs: float = 0.5) -> st.SearchStrategy[np.ndarray]:
     """Angular increments ``(rows, 3)`` (rad) with every component in [−max_abs, max_abs].
 
-    ``rows`` is an int or a strategy of ints. The whole array is scaled by
-    ``10**e``, ``e`` in [−12, 0], so tiny-increment runs (the small-angle branch
-    of every update) are drawn as often as large ones; components shrink to 0.
+    ``rows`` is an int or a strategy of ints. Every component is drawn (no fill
+    value: repeated rows would have no coning, ``θ × θ = 0``). The whole array is
+    scaled by ``10**e``, ``e`` in [−12, 0], so tiny-increment runs (the
+    small-angle branch of every update) are drawn as often as large ones;
+    components shrink to 0.
     """
     rows_st = st.just(int(rows)) if isinstance(rows, int) else rows
     elements = st.floats(-max_abs, max_abs, width=64, **_FLOAT)
-    arrays = rows_st.flatmap(lambda r: hnp.arrays(np.float64, (r, 3), elements=elements))
+    arrays = rows_st.flatmap(lambda r: hnp.arrays(np.float64, (r, 3), elements=elements,
+                                                  fill=st.nothing()))
     scale = st.one_of(st.just(1.0), _log10(-12.0, 0.0))
     return st.builds(lambda a, s: a * s, arrays, scale)
 
