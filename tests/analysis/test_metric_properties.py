@@ -2,7 +2,7 @@
 
 ``attitude_errors`` and ``accumulated_drift`` are even in each quaternion (negation is
 exact), so they are compared bit for bit (the error vector at ``w == 0`` exactly is
-``±π u``, see tests/rotation/test_properties.py). BROAD's metrics go through the
+``±π u``, see tests/rotation/test_rotation_properties.py). BROAD's metrics go through the
 twist angle ``2 atan2(z, w)``, which moves by 2π under the sign change, so its sine,
 cosine and wrapped heading are rounded from a different argument: equal to 1e-12°.
 """
