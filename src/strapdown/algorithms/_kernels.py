@@ -42,9 +42,10 @@ def _rotvec(theta, base, m, k, phi):
 
 
 @njit(cache=True, inline="always")
-def _update(qp, phi, out):
-    """out = normalise(qp ⊗ q(φ)) with the exact exponential map."""
-    ang2 = phi[0] * phi[0] + phi[1] * phi[1] + phi[2] * phi[2]
+def _mul_exp(q0, q1, q2, q3, px, py, pz):
+    """normalise(q ⊗ q(φ)) on scalars, with the exact exponential map (series below
+    :data:`SMALL_ANGLE`); returns (w, x, y, z)."""
+    ang2 = px * px + py * py + pz * pz
     ang = np.sqrt(ang2)
     half = 0.5 * ang
     if half < _SMALL:
@@ -54,18 +55,25 @@ def _update(qp, phi, out):
     else:
         s = np.sin(half) / ang
         dw = np.cos(half)
-    dx = s * phi[0]
-    dy = s * phi[1]
-    dz = s * phi[2]
-    w = qp[0] * dw - qp[1] * dx - qp[2] * dy - qp[3] * dz
-    x = qp[0] * dx + qp[1] * dw + qp[2] * dz - qp[3] * dy
-    y = qp[0] * dy - qp[1] * dz + qp[2] * dw + qp[3] * dx
-    z = qp[0] * dz + qp[1] * dy - qp[2] * dx + qp[3] * dw
+    dx = s * px
+    dy = s * py
+    dz = s * pz
+    w = q0 * dw - q1 * dx - q2 * dy - q3 * dz
+    x = q0 * dx + q1 * dw + q2 * dz - q3 * dy
+    y = q0 * dy - q1 * dz + q2 * dw + q3 * dx
+    z = q0 * dz + q1 * dy - q2 * dx + q3 * dw
     inv = 1.0 / np.sqrt(w * w + x * x + y * y + z * z)
-    out[0] = w * inv
-    out[1] = x * inv
-    out[2] = y * inv
-    out[3] = z * inv
+    return w * inv, x * inv, y * inv, z * inv
+
+
+@njit(cache=True, inline="always")
+def _update(qp, phi, out):
+    """out = normalise(qp ⊗ q(φ)) with the exact exponential map."""
+    w, x, y, z = _mul_exp(qp[0], qp[1], qp[2], qp[3], phi[0], phi[1], phi[2])
+    out[0] = w
+    out[1] = x
+    out[2] = y
+    out[3] = z
 
 
 @njit(cache=True)
@@ -439,29 +447,11 @@ def windowed_kernel(x, offsets, weights, pi, pj, pc, sa, sb, starts, stride, q_o
 @njit(cache=True, inline="always")
 def _update_rows(q, src, px, py, pz, dst):
     """q[dst] = normalise(q[src] ⊗ q(φ)), φ = (px, py, pz): :func:`_update` on scalars."""
-    ang2 = px * px + py * py + pz * pz
-    ang = np.sqrt(ang2)
-    half = 0.5 * ang
-    if half < _SMALL:
-        x2 = half * half
-        s = 0.5 * (1.0 - x2 / 6.0 * (1.0 - x2 / 20.0 * (1.0 - x2 / 42.0)))
-        dw = 1.0 - x2 / 2.0 * (1.0 - x2 / 12.0 * (1.0 - x2 / 30.0 * (1.0 - x2 / 56.0)))
-    else:
-        s = np.sin(half) / ang
-        dw = np.cos(half)
-    dx = s * px
-    dy = s * py
-    dz = s * pz
-    q0, q1, q2, q3 = q[src, 0], q[src, 1], q[src, 2], q[src, 3]
-    w = q0 * dw - q1 * dx - q2 * dy - q3 * dz
-    x = q0 * dx + q1 * dw + q2 * dz - q3 * dy
-    y = q0 * dy - q1 * dz + q2 * dw + q3 * dx
-    z = q0 * dz + q1 * dy - q2 * dx + q3 * dw
-    inv = 1.0 / np.sqrt(w * w + x * x + y * y + z * z)
-    q[dst, 0] = w * inv
-    q[dst, 1] = x * inv
-    q[dst, 2] = y * inv
-    q[dst, 3] = z * inv
+    w, x, y, z = _mul_exp(q[src, 0], q[src, 1], q[src, 2], q[src, 3], px, py, pz)
+    q[dst, 0] = w
+    q[dst, 1] = x
+    q[dst, 2] = y
+    q[dst, 3] = z
 
 
 @njit(cache=True)
