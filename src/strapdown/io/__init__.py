@@ -4,24 +4,7 @@ writing and the report writer.
 The log readers are re-exported here (``strapdown.io.read_imu``).
 """
 
-from strapdown.io.readers import (
-    RATE_PLAUSIBLE_MAX,
-    ImuLog,
-    UnitWarning,
-    check_rows,
-    csv_columns,
-    read_imu,
-    warn_implausible_rate,
-    write_attitude,
-)
+from strapdown.io import readers as _readers
+from strapdown.io.readers import *  # noqa: F403  (the subpackage's public face)
 
-__all__ = [
-    "RATE_PLAUSIBLE_MAX",
-    "ImuLog",
-    "UnitWarning",
-    "check_rows",
-    "csv_columns",
-    "read_imu",
-    "warn_implausible_rate",
-    "write_attitude",
-]
+__all__ = list(_readers.__all__)
