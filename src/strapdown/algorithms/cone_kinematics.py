@@ -30,8 +30,10 @@ All return cone angles (δ1, δ2, δ3) at the step times.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Literal, get_args
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from strapdown._core.validation import positive
 from strapdown.algorithms import _kernels
@@ -43,15 +45,19 @@ from strapdown.rotation.euler import _rx, dcm_from_euler_zyx, euler_zyx_from_dcm
 __all__ = [
     "METHODS",
     "ConeAngleSolution",
+    "ConeMethod",
     "integrate_cone_angles",
     "integrate_cone_angles_reference",
     "right_jacobian",
 ]
 
-METHODS = ("cone", "cone-printed", "nutation", "euler")
+#: The integration methods (see the module docstring).
+ConeMethod = Literal["cone", "cone-printed", "nutation", "euler"]
+#: Their names, in the order the documentation lists them.
+METHODS: tuple[ConeMethod, ...] = get_args(ConeMethod)
 
 
-def right_jacobian(nu: np.ndarray) -> np.ndarray:
+def right_jacobian(nu: NDArray[np.float64]) -> NDArray[np.float64]:
     """``J_r(ν) = I − (1 − cos|ν|)/|ν|² [ν×] + (|ν| − sin|ν|)/|ν|³ [ν×]²`` (series below 1e-4)."""
     a = float(np.linalg.norm(nu))
     k = np.array([[0, -nu[2], nu[1]], [nu[2], 0, -nu[0]], [-nu[1], nu[0], 0]])
@@ -102,9 +108,9 @@ def _from_nutation(y):
 class ConeAngleSolution:
     """Cone angles at the step times (δ1 and δ3 unwrapped, rad)."""
 
-    t: np.ndarray
-    angles: np.ndarray
-    method: str
+    t: NDArray[np.float64]
+    angles: NDArray[np.float64]
+    method: ConeMethod
     switches: int
 
 
@@ -116,8 +122,9 @@ def _rk4(f, y, w0, wm, w1, h):
     return y + h / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
 
 
-def integrate_cone_angles(t, omega, initial, *, method: str = "cone",
-                          switch: float = 1e-3) -> ConeAngleSolution:
+def integrate_cone_angles(t: ArrayLike, omega: ArrayLike, initial: ArrayLike, *,
+                          method: ConeMethod = "cone", switch: float = 1e-3
+                          ) -> ConeAngleSolution:
     """Integrate cone angles from rate samples (compiled; see the module docstring).
 
     Parameters
@@ -151,8 +158,9 @@ def integrate_cone_angles(t, omega, initial, *, method: str = "cone",
                              int(switches))
 
 
-def integrate_cone_angles_reference(t, omega, initial, *, method: str = "cone",
-                                    switch: float = 1e-3) -> ConeAngleSolution:
+def integrate_cone_angles_reference(t: ArrayLike, omega: ArrayLike, initial: ArrayLike, *,
+                                    method: ConeMethod = "cone", switch: float = 1e-3
+                                    ) -> ConeAngleSolution:
     """Plain-Python twin of :func:`integrate_cone_angles` (the kernels are tested against it)."""
     rec = check_rate_record(t, omega, min_samples=3)
     d0 = np.asarray(initial, dtype=np.float64)

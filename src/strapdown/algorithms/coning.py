@@ -31,21 +31,28 @@ A user set is any ``(N, N)`` strictly upper-triangular matrix
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from fractions import Fraction
+from typing import Literal, get_args
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
+from strapdown._core.kinds import InputKind
 from strapdown._core.validation import as_vectors, finite_array, positive_int
 from strapdown.algorithms.errata import eq6_printed_matrix
 
 __all__ = [
+    "CONING_SETS",
     "MAX_SUBSAMPLES",
     "TABLE3",
     "CoefficientSet",
+    "ConingSetName",
     "WindowedAlgorithm",
     "coefficient_set",
     "coefficient_set_names",
+    "coning_set_name",
     "rotation_vectors",
     "table1_drift_constant",
     "user_coefficients",
@@ -56,6 +63,11 @@ __all__ = [
 MAX_SUBSAMPLES = 6
 
 F = Fraction
+
+#: The named coefficient sets (see the module docstring).
+ConingSetName = Literal["table3", "lag", "eq6-printed", "miller", "none"]
+#: Their names, in the order the command line lists them.
+CONING_SETS: tuple[ConingSetName, ...] = get_args(ConingSetName)
 
 #: Li & Zhang 2017 Table 3 (ς_1 … ς_{N−1}); N = 6 is our extension, derived by
 #: the same classical-coning optimisation (exact rationals, checked against the
@@ -106,12 +118,12 @@ class CoefficientSet:
 
     name: str
     n: int
-    matrix: np.ndarray = field(repr=False)
+    matrix: NDArray[np.float64] = field(repr=False)
     exact: tuple[tuple[Fraction, ...], ...] | None = field(default=None, repr=False)
     reference: str = ""
     classical_optimum: bool = False
 
-    def lag_sums(self) -> np.ndarray:
+    def lag_sums(self) -> NDArray[np.float64]:
         """``K_m = Σ_{j−i=m} k_ij`` for ``m = 1 … N−1``."""
         return np.array([np.trace(self.matrix, offset=m) for m in range(1, self.n)])
 
@@ -160,7 +172,7 @@ def _none(n):
     return _from_exact("none", _zeros(n), "no coning correction", n == 1)
 
 
-_REGISTRY = {
+_REGISTRY: dict[ConingSetName, Callable[[int], CoefficientSet]] = {
     "table3": _table3,
     "lag": _lag,
     "eq6-printed": _eq6,
@@ -169,12 +181,22 @@ _REGISTRY = {
 }
 
 
-def coefficient_set_names() -> tuple[str, ...]:
+def coefficient_set_names() -> tuple[ConingSetName, ...]:
     """Names accepted by :func:`coefficient_set`."""
-    return tuple(_REGISTRY)
+    return CONING_SETS
 
 
-def coefficient_set(name: str, n: int) -> CoefficientSet:
+def coning_set_name(name: object) -> ConingSetName:
+    """``name`` if it names a coefficient set, else ValueError listing the names."""
+    if name not in CONING_SETS:
+        raise ValueError(
+            f"unknown coefficient set {name!r}; choose one of {', '.join(CONING_SETS)} "
+            "or pass a matrix to user_coefficients()"
+        )
+    return name
+
+
+def coefficient_set(name: ConingSetName, n: int) -> CoefficientSet:
     """A named coefficient set for ``N = n`` subsamples.
 
     Raises
@@ -183,17 +205,13 @@ def coefficient_set(name: str, n: int) -> CoefficientSet:
         For an unknown name or an N outside ``1 … MAX_SUBSAMPLES``.
     """
     n = positive_int(n, "N (subsamples)")
-    if name not in _REGISTRY:
-        raise ValueError(
-            f"unknown coefficient set {name!r}; choose one of {', '.join(_REGISTRY)} "
-            "or pass a matrix to user_coefficients()"
-        )
+    name = coning_set_name(name)
     if n > MAX_SUBSAMPLES:
         raise ValueError(f"named sets are tabulated for N = 1 … {MAX_SUBSAMPLES}, got N = {n}")
     return _REGISTRY[name](n)
 
 
-def user_coefficients(matrix, *, name: str = "user") -> CoefficientSet:
+def user_coefficients(matrix: ArrayLike, *, name: str = "user") -> CoefficientSet:
     """Wrap a user ``(N, N)`` matrix ``K`` (only the strict upper triangle may be non-zero)."""
     k = finite_array(matrix, "coefficient matrix")
     if k.ndim != 2 or k.shape[0] != k.shape[1] or k.shape[0] < 1:
@@ -206,7 +224,8 @@ def user_coefficients(matrix, *, name: str = "user") -> CoefficientSet:
     return CoefficientSet(name, k.shape[0], k.copy(), None, "user matrix", False)
 
 
-def rotation_vectors(increments, coefficients: CoefficientSet) -> np.ndarray:
+def rotation_vectors(increments: ArrayLike, coefficients: CoefficientSet
+                     ) -> NDArray[np.float64]:
     """Rotation vectors of consecutive non-overlapping groups of N increments.
 
     Parameters
@@ -263,12 +282,12 @@ class WindowedAlgorithm:
     name : str
     """
 
-    input: str
+    input: InputKind
     update: int
     offsets: tuple[int, ...]
-    weights: tuple
+    weights: tuple[Fraction, ...]
     pairs: tuple[tuple[int, int], ...]
-    pair_coefficients: tuple
+    pair_coefficients: tuple[Fraction | float, ...]
     name: str = "windowed"
 
     @property
@@ -281,7 +300,8 @@ class WindowedAlgorithm:
         """Largest node offset (the update needs samples up to b + span)."""
         return max(self.offsets)
 
-    def rotation_vectors(self, samples: np.ndarray, starts: np.ndarray, h: float) -> np.ndarray:
+    def rotation_vectors(self, samples: NDArray[np.float64], starts: NDArray[np.int64],
+                         h: float) -> NDArray[np.float64]:
         """φ for the updates starting at sample indices ``starts`` (vectorised)."""
         idx = starts[:, None] + np.asarray(self.offsets)[None, :]
         s = samples[idx]  # (updates, nodes, 3)

@@ -32,6 +32,7 @@ from collections.abc import Sequence
 from fractions import Fraction
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from strapdown._core.validation import as_dcms, as_vectors
 
@@ -80,7 +81,7 @@ def eq6_printed_matrix(sigma: Sequence[Fraction]) -> list[list[Fraction]]:
 
 
 # ---------------------------------------------------------- Zhang & Yu (2021) eq. 7
-def printed_cone_rates(y, w) -> np.ndarray:
+def printed_cone_rates(y: NDArray[np.float64], w: NDArray[np.float64]) -> NDArray[np.float64]:
     """Cone-angle rates of Zhang & Yu (2021) eq. 7 exactly as printed.
 
     Printed: ``δ̇1 = +(cos e ω_y + sin e ω_z)/sin δ2`` (``e = δ1 − δ3``). Right:
@@ -114,7 +115,8 @@ def printed_cone_rates(y, w) -> np.ndarray:
 
 
 # ------------------------------------------- Zhang & Yu (2021) eqs. 17–22, Tables 1–2
-def paper_dcm_from_cone_angles(d1, d2, d3) -> np.ndarray:
+def paper_dcm_from_cone_angles(d1: ArrayLike, d2: ArrayLike, d3: ArrayLike
+                               ) -> NDArray[np.float64]:
     """Zhang & Yu (2021) eq. 17 (DCM from cone angles) exactly as printed.
 
     Printed: ``C32 = −sin e cos δ1 + cos e cos δ1 sin δ2`` and
@@ -136,7 +138,9 @@ def paper_dcm_from_cone_angles(d1, d2, d3) -> np.ndarray:
     return np.stack([np.stack(r, -1) for r in rows], -2)
 
 
-def paper_cone_angles_from_dcm(dcm) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def paper_cone_angles_from_dcm(dcm: ArrayLike) -> tuple[NDArray[np.float64],
+                                                        NDArray[np.float64],
+                                                        NDArray[np.float64]]:
     """Zhang & Yu (2021) eqs. 18–20 with Tables 1 and 2 exactly as printed.
 
     Printed: ``δ2 = arccos C11`` (eq. 19), δ1 from ``arctan(C31/C21)`` with the
@@ -165,7 +169,8 @@ def paper_cone_angles_from_dcm(dcm) -> tuple[np.ndarray, np.ndarray, np.ndarray]
     return d1, d2, np.mod(d3, _TWO_PI)
 
 
-def paper_pitch_yaw_from_cone_angles(d1, d2) -> tuple[np.ndarray, np.ndarray]:
+def paper_pitch_yaw_from_cone_angles(d1: ArrayLike, d2: ArrayLike
+                                     ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Zhang & Yu (2021) eqs. 21–22 (pitch and yaw from cone angles) as printed.
 
     Printed: ``ϑ = ±arcsin|sin δ1 sin δ2|`` and
@@ -177,13 +182,13 @@ def paper_pitch_yaw_from_cone_angles(d1, d2) -> tuple[np.ndarray, np.ndarray]:
     z-y-x pitch on 100 %; |ψ| equals |yaw| on 100 % of attitudes with δ2 < 90°
     and on none beyond.
     """
-    d1 = np.mod(np.asarray(d1, float), _TWO_PI)
-    d2 = np.asarray(d2, float)
-    theta = np.arcsin(np.abs(np.sin(d1) * np.sin(d2)))
-    theta = np.where(d1 > np.pi, -theta, theta)
-    arg = (np.sin(d2) ** 2 - np.sin(theta) ** 2) / np.cos(theta) ** 2
+    a1: NDArray[np.float64] = np.mod(np.asarray(d1, float), _TWO_PI)
+    a2 = np.asarray(d2, float)
+    theta = np.arcsin(np.abs(np.sin(a1) * np.sin(a2)))
+    theta = np.where(a1 > np.pi, -theta, theta)
+    arg = (np.sin(a2) ** 2 - np.sin(theta) ** 2) / np.cos(theta) ** 2
     psi = np.arcsin(np.sqrt(np.clip(arg, 0.0, 1.0)))
-    psi = np.where((d1 <= np.pi / 2) | (d1 > 1.5 * np.pi), psi, -psi)
+    psi = np.where((a1 <= np.pi / 2) | (a1 > 1.5 * np.pi), psi, -psi)
     return theta, psi
 
 
@@ -191,7 +196,7 @@ def paper_pitch_yaw_from_cone_angles(d1, d2) -> tuple[np.ndarray, np.ndarray]:
 #: Zhang & Yu (2021) Table 7, coefficients quoted from Wang et al. (2015). The
 #: structure they multiply is not printed; :func:`triple_cross_rotation_vectors`
 #: uses our inference.
-TABLE7 = {
+TABLE7: dict[str, float] = {
     "k11": 0.45, "k12": 0.675,
     "k112": -1.2229, "k212": 1.0021, "k312": 0.0396,
     "k123": -0.3771, "k223": 1.2354, "k323": -0.3396,
@@ -199,8 +204,9 @@ TABLE7 = {
 }
 
 
-def triple_cross_rotation_vectors(increments, coefficients: dict | None = None,
-                                  *, triple: bool = True) -> np.ndarray:
+def triple_cross_rotation_vectors(increments: ArrayLike,
+                                  coefficients: dict[str, float] | None = None,
+                                  *, triple: bool = True) -> NDArray[np.float64]:
     """Three-subsample rotation vectors with the triple-cross-product terms of Table 7.
 
     Printed (Zhang & Yu (2021) Table 7, quoting Wang et al. (2015)): the

@@ -13,17 +13,49 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from fractions import Fraction
-from typing import TYPE_CHECKING, ClassVar, Literal
+from typing import TYPE_CHECKING, Any, ClassVar, Literal
+
+from strapdown._core.kinds import InputKind
 
 if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
+
+    from strapdown.algorithms.coning import ConingSetName
     from strapdown.algorithms.precision import MpSolution
     from strapdown.algorithms.spec import AlgorithmSpec
     from strapdown.algorithms.structures import AttitudeSolution
     from strapdown.truth.motions import Motion
 
-__all__ = ["DriftLaw", "Family", "InputKind"]
+__all__ = [
+    "AlgorithmName",
+    "DriftLaw",
+    "Family",
+    "IncrementStructure",
+    "InputKind",
+    "QuaternionAlgorithmName",
+    "RateAlgorithmName",
+    "RateCoefficients",
+    "Rk4Step",
+    "StructureName",
+]
 
-InputKind = Literal["increment", "rate"]
+# The vocabulary of an algorithm spec: every string option, once. The run-time tuples
+# (spec.ALGORITHMS, structures.STRUCTURES, rate.RK4_STEPS …) are derived from these.
+#: The rate-input families (:mod:`.rate`).
+RateAlgorithmName = Literal["rate-single", "rate-three", "rk4"]
+#: Plaksiy's quaternion algorithms A1–A3 (:mod:`.quaternion`).
+QuaternionAlgorithmName = Literal["miller", "panov", "power"]
+#: Every registered family, in registry order (:data:`strapdown.algorithms.spec.REGISTRY`).
+AlgorithmName = Literal["rotvec", RateAlgorithmName, QuaternionAlgorithmName]
+#: The update structures of increment input (:mod:`.structures`).
+IncrementStructure = Literal["conventional", "realtime", "single-chain"]
+#: Every update structure some family runs in (``sliding``: Wang et al.'s scheme of
+#: ``rate-three``).
+StructureName = Literal[IncrementStructure, "sliding"]
+#: RK4 step variants: step 2 td with the middle sample, or step td with the mean of the ends.
+Rk4Step = Literal["2td", "td-interp"]
+#: Coefficient sets of the rate algorithms: the designer's (``derived``) or as printed.
+RateCoefficients = Literal["derived", "paper"]
 
 
 @dataclass(frozen=True)
@@ -49,11 +81,11 @@ class Family:
     """
 
     #: Registry name, the first field of a spec string.
-    name: ClassVar[str]
+    name: ClassVar[AlgorithmName]
     #: What the algorithm consumes: angular increments (rad) or rate samples (rad/s).
     input_kind: ClassVar[InputKind]
     #: Update structures it runs in; the first is the default.
-    structures: ClassVar[tuple[str, ...]] = ("conventional",)
+    structures: ClassVar[tuple[StructureName, ...]] = ("conventional",)
     #: Spec fields besides ``algorithm``/``structure``/``coefficients`` that it reads.
     options: ClassVar[frozenset[str]] = frozenset()
     #: Whether the input comes in whole computation steps ``spec.step`` of
@@ -61,11 +93,11 @@ class Family:
     #: sample rate.
     stepped: ClassVar[bool] = False
     #: Default coefficient set (``None``: the family takes no ``coefficients``).
-    default_coefficients: ClassVar[str | None] = None
+    default_coefficients: ClassVar[ConingSetName | RateCoefficients | None] = None
     #: Full reference of the algorithm (see docs/references.md).
     reference: ClassVar[str] = ""
 
-    def coefficient_names(self) -> tuple[str, ...]:
+    def coefficient_names(self) -> tuple[ConingSetName | RateCoefficients, ...]:
         """Names ``coefficients=`` accepts (empty: none)."""
         return ()
 
@@ -96,8 +128,8 @@ class Family:
         """The classical-coning drift law, where one is known."""
         return None
 
-    def run(self, spec: AlgorithmSpec, data, *, h: float, t=None, t0: float = 0.0,
-            q0=None) -> AttitudeSolution:
+    def run(self, spec: AlgorithmSpec, data: ArrayLike, *, h: float, t: ArrayLike | None = None,
+            t0: float = 0.0, q0: ArrayLike | None = None) -> AttitudeSolution:
         """Run on validated input: increments ``(n, 3)`` every ``h`` from ``t0``, or rates
         ``(n, 3)`` at times ``t``."""
         raise NotImplementedError
@@ -107,7 +139,7 @@ class Family:
         """Run on a closed-form motion in arbitrary precision."""
         raise ValueError(f"{self.name} runs in float64 only; drop --precision")
 
-    def propagation(self, spec: AlgorithmSpec) -> dict:
+    def propagation(self, spec: AlgorithmSpec) -> dict[str, Any]:
         """Arguments of the AHRS kernel's propagation step (see :mod:`strapdown.ahrs`)."""
         raise ValueError(f"the filter propagates with rate-single, rate-three (sliding), rk4 or "
                          f"rotvec:N=…, not {self.name!r}")

@@ -16,14 +16,17 @@ hour-long computation silently.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import get_args
 
 import mpmath
 import numpy as np
+from numpy.typing import NDArray
 
 from strapdown._core.backend import MPMATH
 from strapdown._core.validation import positive, positive_int
 from strapdown.algorithms import _reference
 from strapdown.algorithms.coning import CoefficientSet, WindowedAlgorithm
+from strapdown.algorithms.family import IncrementStructure, Rk4Step
 from strapdown.algorithms.structures import STRUCTURES, startup_sets
 from strapdown.truth.motions import Motion
 
@@ -53,10 +56,10 @@ class MpSolution:
         First steady-state output (see :class:`strapdown.algorithms.structures.AttitudeSolution`).
     """
 
-    t: np.ndarray
-    err: np.ndarray
-    angle: np.ndarray
-    chain: np.ndarray
+    t: NDArray[np.float64]
+    err: NDArray[np.float64]
+    angle: NDArray[np.float64]
+    chain: NDArray[np.int_]
     digits: int
     startup: int = 0
 
@@ -192,7 +195,7 @@ def run_mp(
     motion: Motion,
     coefficients: CoefficientSet,
     *,
-    structure: str,
+    structure: IncrementStructure,
     h: float,
     samples: int,
     digits: int = 50,
@@ -249,11 +252,11 @@ def run_mp(
         return _errors(motion, q, t_out, chain, digits)
 
 
-def run_rk4_mp(motion: Motion, *, h: float, samples: int, step: str = "2td", digits: int = 50,
-               t0: float = 0.0) -> MpSolution:
+def run_rk4_mp(motion: Motion, *, h: float, samples: int, step: Rk4Step = "2td",
+               digits: int = 50, t0: float = 0.0) -> MpSolution:
     """Quaternion RK4 on exact rate samples in arbitrary precision (see
     :mod:`strapdown.algorithms.rate`)."""
-    if step not in ("2td", "td-interp"):
+    if step not in get_args(Rk4Step):
         raise ValueError(f"step must be '2td' or 'td-interp', got {step!r}")
     h, samples, digits = _check_run(motion, h, samples, digits)
     mode = 0 if step == "2td" else 1

@@ -19,24 +19,31 @@ exponential map. ``exact_exp=True`` uses the exponential map instead (for A3:
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, ClassVar, get_args
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from strapdown._core.validation import as_quaternions, as_vectors, finite_array, positive
 from strapdown.algorithms import _kernels
-from strapdown.algorithms.family import Family
+from strapdown.algorithms.family import Family, QuaternionAlgorithmName
 from strapdown.algorithms.structures import AttitudeSolution
+
+if TYPE_CHECKING:
+    from strapdown.algorithms.spec import AlgorithmSpec
 
 __all__ = ["ALGORITHMS", "FAMILIES", "STATED", "QuaternionAlgorithm", "quaternion_attitude",
            "subintervals"]
 
-ALGORITHMS = ("miller", "panov", "power")
+#: The algorithms (:data:`~strapdown.algorithms.family.QuaternionAlgorithmName`).
+ALGORITHMS: tuple[QuaternionAlgorithmName, ...] = get_args(QuaternionAlgorithmName)
 #: Coefficients as the paper states them (α, β).
-STATED = {"miller": (33 / 80, 57 / 80), "panov": (2 / 3, 0.0), "power": (1 / 3, 0.0)}
-_MODE = {"miller": 1, "panov": 2, "power": 3}
+STATED: dict[QuaternionAlgorithmName, tuple[float, float]] = {
+    "miller": (33 / 80, 57 / 80), "panov": (2 / 3, 0.0), "power": (1 / 3, 0.0)}
+_MODE: dict[QuaternionAlgorithmName, int] = {"miller": 1, "panov": 2, "power": 3}
 
 
-def subintervals(algorithm: str) -> int:
+def subintervals(algorithm: QuaternionAlgorithmName) -> int:
     """Increments per step: 3 for Miller (thirds), 2 for Panov and power (halves)."""
     if algorithm not in ALGORITHMS:
         raise ValueError(f"unknown algorithm {algorithm!r}; choose one of {', '.join(ALGORITHMS)}")
@@ -47,27 +54,28 @@ def subintervals(algorithm: str) -> int:
 class QuaternionAlgorithm:
     """One configured algorithm: name, coefficients, increment map."""
 
-    name: str
+    name: QuaternionAlgorithmName
     alpha: float
     beta: float = 0.0
     exact_exp: bool = False
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         subintervals(self.name)
         finite_array([self.alpha, self.beta], "alpha/beta")
         if self.name != "miller" and self.beta != 0.0:
             raise ValueError(f"{self.name} has one coefficient (alpha); beta must be 0")
 
     @classmethod
-    def stated(cls, name: str, *, exact_exp: bool = False) -> QuaternionAlgorithm:
+    def stated(cls, name: QuaternionAlgorithmName, *, exact_exp: bool = False
+               ) -> QuaternionAlgorithm:
         """The paper's stated coefficients."""
         subintervals(name)
         a, b = STATED[name]
         return cls(name, a, b, exact_exp)
 
 
-def quaternion_attitude(increments, algorithm: QuaternionAlgorithm, *, step: float,
-                        t0: float = 0.0, q0=None) -> AttitudeSolution:
+def quaternion_attitude(increments: ArrayLike, algorithm: QuaternionAlgorithm, *, step: float,
+                        t0: float = 0.0, q0: ArrayLike | None = None) -> AttitudeSolution:
     """Run A1/A2/A3 on sub-interval increments.
 
     Parameters
@@ -106,13 +114,14 @@ def quaternion_attitude(increments, algorithm: QuaternionAlgorithm, *, step: flo
 class _QuaternionFamily(Family):
     """Plaksiy's A1–A3: increments over sub-intervals of the computation step ΔT."""
 
+    name: ClassVar[QuaternionAlgorithmName]
     input_kind = "increment"
     stepped = True
     options = frozenset({"alpha", "beta", "step", "exact_exp"})
     reference = ("Plaksiy (2024): quaternion algorithms A1 (Miller), A2 (Panov), A3 (power) "
                  "on the spherical (Krylov-angle) model")
 
-    def check(self, spec) -> None:
+    def check(self, spec: AlgorithmSpec) -> None:
         if spec.coefficients is not None:
             raise ValueError(f"{self.name} takes --alpha/--beta, not --coefficients")
         if spec.beta is not None and self.name != "miller":
@@ -120,24 +129,25 @@ class _QuaternionFamily(Family):
         self._step(spec)
         super().check(spec)
 
-    def configured(self, spec) -> QuaternionAlgorithm:
+    def configured(self, spec: AlgorithmSpec) -> QuaternionAlgorithm:
         """The algorithm with the spec's coefficients (the paper's stated ones by default)."""
         a0, b0 = STATED[self.name]
         return QuaternionAlgorithm(self.name, a0 if spec.alpha is None else spec.alpha,
                                    b0 if spec.beta is None else spec.beta, spec.exact_exp)
 
-    def _step(self, spec) -> float:
+    def _step(self, spec: AlgorithmSpec) -> float:
         if spec.step is None:
             raise ValueError(f"{self.name} needs --step (the computation step ΔT, s)")
         return spec.step
 
-    def min_samples(self, spec) -> int:
+    def min_samples(self, spec: AlgorithmSpec) -> int:
         return subintervals(self.name)
 
-    def update_period(self, spec, h: float) -> float:
+    def update_period(self, spec: AlgorithmSpec, h: float) -> float:
         return self._step(spec)
 
-    def run(self, spec, data, *, h, t=None, t0=0.0, q0=None) -> AttitudeSolution:
+    def run(self, spec: AlgorithmSpec, data: ArrayLike, *, h: float, t: ArrayLike | None = None,
+            t0: float = 0.0, q0: ArrayLike | None = None) -> AttitudeSolution:
         return quaternion_attitude(data, self.configured(spec), step=self._step(spec), t0=t0,
                                    q0=q0)
 

@@ -31,14 +31,28 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from fractions import Fraction
+from typing import TYPE_CHECKING, Any, ClassVar, get_args
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from strapdown._core.validation import as_quaternions, finite_array, first_bad_step
 from strapdown.algorithms import _kernels, tables
 from strapdown.algorithms.coning import WindowedAlgorithm
-from strapdown.algorithms.family import DriftLaw, Family
+from strapdown.algorithms.family import (
+    DriftLaw,
+    Family,
+    RateAlgorithmName,
+    RateCoefficients,
+    Rk4Step,
+    StructureName,
+)
 from strapdown.algorithms.structures import AttitudeSolution, _windowed
+
+if TYPE_CHECKING:
+    from strapdown.algorithms.precision import MpSolution
+    from strapdown.algorithms.spec import AlgorithmSpec
+    from strapdown.truth.motions import Motion
 
 __all__ = [
     "ALGORITHMS",
@@ -55,8 +69,10 @@ __all__ = [
 ]
 
 F = Fraction
-COEFFICIENTS = ("derived", "paper")
-RK4_STEPS = ("2td", "td-interp")
+#: Coefficient sets of the rate algorithms (:data:`~strapdown.algorithms.family.RateCoefficients`).
+COEFFICIENTS: tuple[RateCoefficients, ...] = get_args(RateCoefficients)
+#: RK4 step variants (:data:`~strapdown.algorithms.family.Rk4Step`).
+RK4_STEPS: tuple[Rk4Step, ...] = get_args(Rk4Step)
 #: Classical-coning drift (order, c) of RK4, drift = −c·a²Ω(Ωtd)^order; derived symbolically
 #: by :func:`strapdown.design.rk4_classical_coning_drift` (re-derived in the test suite).
 RK4_DRIFT = tables.RK4_DRIFT
@@ -68,12 +84,12 @@ UNIFORM_TOLERANCE = 1e-6
 class RateRecord:
     """Validated uniformly sampled rates."""
 
-    t: np.ndarray
-    omega: np.ndarray
+    t: NDArray[np.float64]
+    omega: NDArray[np.float64]
     td: float
 
 
-def check_rate_record(t, omega, *, min_samples: int = 2) -> RateRecord:
+def check_rate_record(t: ArrayLike, omega: ArrayLike, *, min_samples: int = 2) -> RateRecord:
     """Validate time stamps and rates; errors name the offending row.
 
     Raises on NaN/inf (row given), shape mismatch, non-increasing or
@@ -115,39 +131,44 @@ def check_rate_record(t, omega, *, min_samples: int = 2) -> RateRecord:
     return RateRecord(t, w, td)
 
 
-def single_period_algorithm(coefficients: str = "derived") -> WindowedAlgorithm:
+def single_period_algorithm(coefficients: RateCoefficients = "derived") -> WindowedAlgorithm:
     """The single-period rate algorithm as a windowed algorithm (update every td)."""
     c = _single_coefficient(coefficients)
     return WindowedAlgorithm("rate", 1, (0, 1), (F(1, 2), F(1, 2)), ((0, 1),), (c,),
                              f"rate-single ({coefficients})")
 
 
-def _single_coefficient(coefficients: str) -> Fraction:
-    if coefficients not in tables.RATE_SINGLE:
+def _single_coefficient(coefficients: RateCoefficients) -> Fraction:
+    return tables.RATE_SINGLE[_rate_coefficients(coefficients)]
+
+
+def _rate_coefficients(name: object) -> RateCoefficients:
+    """``name`` if it is a rate coefficient set, else ValueError listing the sets."""
+    if name not in COEFFICIENTS:
         raise ValueError(f"rate coefficients must be one of {', '.join(COEFFICIENTS)}, "
-                         f"got {coefficients!r}")
-    return tables.RATE_SINGLE[coefficients]
+                         f"got {name!r}")
+    return name
 
 
-def three_period_algorithm(coefficients: str = "derived") -> WindowedAlgorithm:
+def three_period_algorithm(coefficients: RateCoefficients = "derived") -> WindowedAlgorithm:
     """The three-period rate algorithm (update every 3 td), coefficients from
     :data:`strapdown.algorithms.tables.RATE_THREE`."""
-    if coefficients not in tables.RATE_THREE:
-        raise ValueError(f"rate coefficients must be one of {', '.join(COEFFICIENTS)}, "
-                         f"got {coefficients!r}")
+    coefficients = _rate_coefficients(coefficients)
     return WindowedAlgorithm("rate", 3, (0, 1, 2, 3), tables.RATE_THREE_WEIGHTS,
                              tables.RATE_THREE_PAIRS, tables.RATE_THREE[coefficients],
                              f"rate-three ({coefficients})")
 
 
-def _check_step(step):
+def _check_step(step: object) -> Rk4Step:
     if step not in RK4_STEPS:
         raise ValueError(f"rk4_step must be one of {', '.join(RK4_STEPS)}, got {step!r}")
+    return step
 
 
-def rate_attitude(t, omega, *, algorithm: str, structure: str = "conventional",
-                  coefficients: str = "derived", rk4_step: str = "2td",
-                  q0=None) -> AttitudeSolution:
+def rate_attitude(t: ArrayLike, omega: ArrayLike, *, algorithm: RateAlgorithmName,
+                  structure: StructureName = "conventional",
+                  coefficients: RateCoefficients = "derived", rk4_step: Rk4Step = "2td",
+                  q0: ArrayLike | None = None) -> AttitudeSolution:
     """Attitude from uniformly sampled rates.
 
     A convenience over :class:`~strapdown.algorithms.spec.AlgorithmSpec` for the rate
@@ -183,33 +204,41 @@ def rate_attitude(t, omega, *, algorithm: str, structure: str = "conventional",
     return spec.run_rates(t, omega, q0=q0)
 
 
+def _coefficients(spec: AlgorithmSpec) -> RateCoefficients:
+    """The rate coefficient set a spec runs (the family default when it names none)."""
+    return _rate_coefficients(spec.resolved_coefficients)
+
+
 class _RateFamily(Family):
     """Shared by the windowed rate families: validated record in, attitude out."""
 
     input_kind = "rate"
-    default_coefficients = "derived"
+    default_coefficients: ClassVar[RateCoefficients | None] = "derived"
     reference = ""
 
-    def coefficient_names(self) -> tuple[str, ...]:
+    def coefficient_names(self) -> tuple[RateCoefficients, ...]:
         return COEFFICIENTS
 
-    def windowed(self, spec) -> WindowedAlgorithm:
+    def windowed(self, spec: AlgorithmSpec) -> WindowedAlgorithm:
         """The configured windowed algorithm (what the C exporter and the filter need)."""
         raise NotImplementedError
 
-    def run(self, spec, data, *, h, t=None, t0=0.0, q0=None) -> AttitudeSolution:
+    def run(self, spec: AlgorithmSpec, data: ArrayLike, *, h: float, t: ArrayLike | None = None,
+            t0: float = 0.0, q0: ArrayLike | None = None) -> AttitudeSolution:
+        if t is None:
+            raise ValueError(f"{self.name} needs the sample times t of the rates")
         rec = check_rate_record(t, data, min_samples=self.min_samples(spec))
         w = np.ascontiguousarray(rec.omega)  # validated once, by check_rate_record
         sliding = spec.structure == "sliding"
-        startup = single_period_algorithm(spec.resolved_coefficients) if sliding else None
+        startup = single_period_algorithm(_coefficients(spec)) if sliding else None
         return _windowed(w, self.windowed(spec), rec.td, float(rec.t[0]), _q0(q0), sliding,
                          startup)
 
-    def propagation(self, spec) -> dict:
+    def propagation(self, spec: AlgorithmSpec) -> dict[str, Any]:
         w = self.windowed(spec)
         sliding = spec.structure == "sliding"
         # the sliding scheme starts with single-period steps of the same coefficient set
-        start_c = (float(single_period_algorithm(spec.resolved_coefficients)
+        start_c = (float(single_period_algorithm(_coefficients(spec))
                          .pair_coefficients[0]) if sliding else 0.0)
         return dict(is_rate=True, offsets=np.array(w.offsets, np.int64),
                     weights=np.array([float(x) for x in w.weights]),
@@ -227,19 +256,20 @@ class RateSingle(_RateFamily):
     reference = ("Wang, Wang & Wang: single-period rate algorithm (start-up form; c = 1/12 "
                  "as printed, c = 1/6 derived)")
 
-    def windowed(self, spec) -> WindowedAlgorithm:
-        return single_period_algorithm(spec.resolved_coefficients)
+    def windowed(self, spec: AlgorithmSpec) -> WindowedAlgorithm:
+        return single_period_algorithm(_coefficients(spec))
 
-    def min_samples(self, spec) -> int:
+    def min_samples(self, spec: AlgorithmSpec) -> int:
         return 2
 
-    def update_period(self, spec, h: float) -> float:
+    def update_period(self, spec: AlgorithmSpec, h: float) -> float:
         return h
 
-    def drift_law(self, spec) -> DriftLaw:
-        return DriftLaw(*tables.RATE_SINGLE_DRIFT[spec.resolved_coefficients])
+    def drift_law(self, spec: AlgorithmSpec) -> DriftLaw:
+        return DriftLaw(*tables.RATE_SINGLE_DRIFT[_coefficients(spec)])
 
-    def run_mp(self, spec, motion, *, h, samples, digits):
+    def run_mp(self, spec: AlgorithmSpec, motion: Motion, *, h: float, samples: int,
+               digits: int) -> MpSolution:
         from strapdown.algorithms.precision import run_windowed_mp
 
         return run_windowed_mp(motion, self.windowed(spec), h=h, updates=samples - 1,
@@ -250,26 +280,27 @@ class RateThree(_RateFamily):
     """``rate-three``: the three-period cubic-fit algorithm, conventional or sliding."""
 
     name = "rate-three"
-    structures = ("conventional", "sliding")
+    structures: ClassVar[tuple[StructureName, ...]] = ("conventional", "sliding")
     reference = ("Wang, Wang & Wang: three-period cubic-fit algorithm, eqs. 4-17 as "
                  "reconstructed; sliding scheme eqs. 20-29")
 
-    def windowed(self, spec) -> WindowedAlgorithm:
-        return three_period_algorithm(spec.resolved_coefficients)
+    def windowed(self, spec: AlgorithmSpec) -> WindowedAlgorithm:
+        return three_period_algorithm(_coefficients(spec))
 
-    def min_samples(self, spec) -> int:
+    def min_samples(self, spec: AlgorithmSpec) -> int:
         return 4
 
-    def update_period(self, spec, h: float) -> float:
+    def update_period(self, spec: AlgorithmSpec, h: float) -> float:
         return h if spec.structure == "sliding" else 3 * h
 
-    def drift_law(self, spec) -> DriftLaw:
-        return DriftLaw(*tables.RATE_THREE_DRIFT[spec.resolved_coefficients])
+    def drift_law(self, spec: AlgorithmSpec) -> DriftLaw:
+        return DriftLaw(*tables.RATE_THREE_DRIFT[_coefficients(spec)])
 
-    def run_mp(self, spec, motion, *, h, samples, digits):
+    def run_mp(self, spec: AlgorithmSpec, motion: Motion, *, h: float, samples: int,
+               digits: int) -> MpSolution:
         from strapdown.algorithms.precision import run_windowed_mp
 
-        c = spec.resolved_coefficients
+        c = _coefficients(spec)
         if spec.structure == "sliding":
             return run_windowed_mp(motion, self.windowed(spec), h=h, updates=samples - 3,
                                    digits=digits, sliding=True,
@@ -287,20 +318,23 @@ class Rk4(Family):
     reference = ("Quaternion 4th-order Runge-Kutta on q' = q (x) [0, w] / 2, step 2 td "
                  "(Wang, Wang & Wang's baseline)")
 
-    def check(self, spec) -> None:
+    def check(self, spec: AlgorithmSpec) -> None:
         super().check(spec)
         _check_step(spec.rk4_step)
 
-    def min_samples(self, spec) -> int:
+    def min_samples(self, spec: AlgorithmSpec) -> int:
         return 3 if spec.rk4_step == "2td" else 2
 
-    def update_period(self, spec, h: float) -> float:
+    def update_period(self, spec: AlgorithmSpec, h: float) -> float:
         return 2 * h if spec.rk4_step == "2td" else h
 
-    def drift_law(self, spec) -> DriftLaw:
+    def drift_law(self, spec: AlgorithmSpec) -> DriftLaw:
         return DriftLaw(*RK4_DRIFT[spec.rk4_step])
 
-    def run(self, spec, data, *, h, t=None, t0=0.0, q0=None) -> AttitudeSolution:
+    def run(self, spec: AlgorithmSpec, data: ArrayLike, *, h: float, t: ArrayLike | None = None,
+            t0: float = 0.0, q0: ArrayLike | None = None) -> AttitudeSolution:
+        if t is None:
+            raise ValueError("rk4 needs the sample times t of the rates")
         rec = check_rate_record(t, data, min_samples=self.min_samples(spec))
         mode = 0 if spec.rk4_step == "2td" else 1
         stride = 2 if mode == 0 else 1
@@ -311,12 +345,13 @@ class Rk4(Family):
         return AttitudeSolution(tt, q, "rk4", None, rec.td, stride * rec.td,
                                 np.zeros(m + 1, int))
 
-    def run_mp(self, spec, motion, *, h, samples, digits):
+    def run_mp(self, spec: AlgorithmSpec, motion: Motion, *, h: float, samples: int,
+               digits: int) -> MpSolution:
         from strapdown.algorithms.precision import run_rk4_mp
 
         return run_rk4_mp(motion, h=h, samples=samples, step=spec.rk4_step, digits=digits)
 
-    def propagation(self, spec) -> dict:
+    def propagation(self, spec: AlgorithmSpec) -> dict[str, Any]:
         if spec.rk4_step != "2td" or spec.structure != "conventional":
             raise ValueError("the filter's rk4 is the 2td step, conventional structure")
         i0, f0 = np.zeros(0, np.int64), np.zeros(0)
@@ -326,10 +361,11 @@ class Rk4(Family):
 
 #: The families this module defines, in registry order.
 FAMILIES: tuple[Family, ...] = (RateSingle(), RateThree(), Rk4())
-ALGORITHMS = tuple(f.name for f in FAMILIES)
+#: Their names (:data:`~strapdown.algorithms.family.RateAlgorithmName`), in registry order.
+ALGORITHMS: tuple[RateAlgorithmName, ...] = get_args(RateAlgorithmName)
 
 
-def _q0(q0):
+def _q0(q0: ArrayLike | None) -> NDArray[np.float64]:
     if q0 is None:
         return np.array([1.0, 0.0, 0.0, 0.0])
     q = as_quaternions(q0, "q0")

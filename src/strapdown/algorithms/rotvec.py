@@ -15,19 +15,25 @@ design (:func:`strapdown.design.single_chain_structure`).
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any, ClassVar
 
 from strapdown.algorithms.coning import (
     CoefficientSet,
+    ConingSetName,
     coefficient_set,
     coefficient_set_names,
+    coning_set_name,
     table1_drift_constant,
 )
-from strapdown.algorithms.family import DriftLaw, Family
+from strapdown.algorithms.family import DriftLaw, Family, IncrementStructure
 from strapdown.algorithms.structures import AttitudeSolution, run_structure
 
 if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
+
+    from strapdown.algorithms.precision import MpSolution
     from strapdown.algorithms.spec import AlgorithmSpec
+    from strapdown.truth.motions import Motion
 
 __all__ = ["FAMILIES", "Rotvec"]
 
@@ -37,14 +43,15 @@ class Rotvec(Family):
 
     name = "rotvec"
     input_kind = "increment"
-    structures = ("conventional", "realtime", "single-chain")
+    structures: ClassVar[tuple[IncrementStructure, ...]] = ("conventional", "realtime",
+                                                           "single-chain")
     options = frozenset({"subsamples"})
     default_coefficients = "table3"
     reference = ("Li & Zhang 2017, J. Control Sci. Eng. 9542423: eq. 6 (pair form), eq. 9 "
                  "(rotation vector), eq. 10 (conventional), eq. 15 (real-time); single chain: "
                  "strapdown designer (c_m = (K_m - (N-m)/2)/N)")
 
-    def coefficient_names(self) -> tuple[str, ...]:
+    def coefficient_names(self) -> tuple[ConingSetName, ...]:
         return coefficient_set_names()
 
     def check(self, spec: AlgorithmSpec) -> None:
@@ -53,7 +60,7 @@ class Rotvec(Family):
 
     def coefficient_set(self, spec: AlgorithmSpec) -> CoefficientSet:
         """The configured coefficient set (what the C exporter and the filter need)."""
-        return coefficient_set(spec.resolved_coefficients, spec.subsamples)
+        return coefficient_set(coning_set_name(spec.resolved_coefficients), spec.subsamples)
 
     def min_samples(self, spec: AlgorithmSpec) -> int:
         return 1 if spec.structure == "single-chain" else spec.subsamples
@@ -67,18 +74,19 @@ class Rotvec(Family):
             return None
         return DriftLaw(2 * cs.n, table1_drift_constant(cs.n))
 
-    def run(self, spec: AlgorithmSpec, data, *, h: float, t=None, t0: float = 0.0,
-            q0=None) -> AttitudeSolution:
-        return run_structure(spec.structure, data, self.coefficient_set(spec), h=h, t0=t0,
+    def run(self, spec: AlgorithmSpec, data: ArrayLike, *, h: float, t: ArrayLike | None = None,
+            t0: float = 0.0, q0: ArrayLike | None = None) -> AttitudeSolution:
+        return run_structure(_structure(spec), data, self.coefficient_set(spec), h=h, t0=t0,
                              q0=q0)
 
-    def run_mp(self, spec: AlgorithmSpec, motion, *, h: float, samples: int, digits: int):
+    def run_mp(self, spec: AlgorithmSpec, motion: Motion, *, h: float, samples: int,
+               digits: int) -> MpSolution:
         from strapdown.algorithms.precision import run_mp
 
-        return run_mp(motion, self.coefficient_set(spec), structure=spec.structure, h=h,
+        return run_mp(motion, self.coefficient_set(spec), structure=_structure(spec), h=h,
                       samples=samples, digits=digits)
 
-    def propagation(self, spec: AlgorithmSpec) -> dict:
+    def propagation(self, spec: AlgorithmSpec) -> dict[str, Any]:
         import numpy as np
 
         if spec.structure != "conventional":
@@ -89,6 +97,15 @@ class Rotvec(Family):
         return dict(is_rate=False, offsets=np.arange(n, dtype=np.int64), weights=np.ones(n),
                     pi=ii.astype(np.int64), pj=jj.astype(np.int64), pc=cs.matrix[ii, jj],
                     stride=n, span=n - 1, end_off=n, lag=1, start_c=0.0, rk4=False)
+
+
+def _structure(spec: AlgorithmSpec) -> IncrementStructure:
+    """The spec's structure, one of the increment structures (checked on construction)."""
+    s = spec.structure
+    if s == "sliding":
+        raise ValueError("rotvec runs in the conventional, realtime or single-chain structure, "
+                         "not 'sliding'")
+    return s
 
 
 #: The families this module defines, in registry order.

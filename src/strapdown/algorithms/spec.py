@@ -21,13 +21,29 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any, get_args
 
 from strapdown._core.validation import positive, positive_int
 from strapdown.algorithms import quaternion, rate, rotvec
-from strapdown.algorithms.coning import MAX_SUBSAMPLES
-from strapdown.algorithms.family import DriftLaw, Family, InputKind
+from strapdown.algorithms.coning import MAX_SUBSAMPLES, ConingSetName
+from strapdown.algorithms.family import (
+    AlgorithmName,
+    DriftLaw,
+    Family,
+    InputKind,
+    RateCoefficients,
+    Rk4Step,
+    StructureName,
+)
 from strapdown.algorithms.structures import AttitudeSolution
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
+
+    from strapdown.algorithms.precision import MpSolution
+    from strapdown.io.readers import ImuLog
+    from strapdown.truth.motions import Motion
+    from strapdown.truth.sensors import GyroRecord
 
 __all__ = [
     "ALGORITHMS",
@@ -35,19 +51,25 @@ __all__ = [
     "SPEC_KEYS",
     "STRUCTURES",
     "AlgorithmSpec",
+    "CoefficientName",
     "algorithms_taking",
     "family",
     "parse_spec",
 ]
 
+#: A coefficient set some family takes: a named coning set or a rate-algorithm set.
+CoefficientName = ConingSetName | RateCoefficients
 #: Every registered family by name, in the order the command line lists them.
-REGISTRY: dict[str, Family] = {f.name: f for f in (*rotvec.FAMILIES, *rate.FAMILIES,
-                                                    *quaternion.FAMILIES)}
+REGISTRY: dict[AlgorithmName, Family] = {f.name: f for f in (*rotvec.FAMILIES, *rate.FAMILIES,
+                                                              *quaternion.FAMILIES)}
+if tuple(REGISTRY) != get_args(AlgorithmName):  # the one list of names is the Literal
+    raise RuntimeError(f"the registry {tuple(REGISTRY)} and AlgorithmName "
+                       f"{get_args(AlgorithmName)} disagree; a family was added to one only")
 #: Registered family names.
-ALGORITHMS: tuple[str, ...] = tuple(REGISTRY)
+ALGORITHMS: tuple[AlgorithmName, ...] = tuple(REGISTRY)
 #: Every update structure some family runs in.
-STRUCTURES: tuple[str, ...] = tuple(dict.fromkeys(s for f in REGISTRY.values()
-                                                  for s in f.structures))
+STRUCTURES: tuple[StructureName, ...] = tuple(dict.fromkeys(s for f in REGISTRY.values()
+                                                            for s in f.structures))
 #: Spec fields a spec string may set (``N`` is short for ``subsamples``).
 SPEC_KEYS = ("subsamples", "coefficients", "structure", "rk4_step", "alpha", "beta", "step",
              "exact_exp")
@@ -57,7 +79,7 @@ _FLOAT = {"alpha", "beta", "step"}
 _BOOL = {"exact_exp"}
 
 
-def family(name: str) -> Family:
+def family(name: AlgorithmName) -> Family:
     """The registered family ``name``; an unknown name lists the known ones."""
     try:
         return REGISTRY[name]
@@ -66,7 +88,7 @@ def family(name: str) -> Family:
                          f"{', '.join(ALGORITHMS)}") from None
 
 
-def algorithms_taking(kind: InputKind) -> tuple[str, ...]:
+def algorithms_taking(kind: InputKind) -> tuple[AlgorithmName, ...]:
     """Names of the families whose input is ``kind`` (``"increment"`` or ``"rate"``)."""
     return tuple(n for n, f in REGISTRY.items() if f.input_kind == kind)
 
@@ -77,15 +99,15 @@ class AlgorithmSpec:
 
     Parameters
     ----------
-    algorithm : str
+    algorithm : AlgorithmName
         Family name, one of :data:`ALGORITHMS`.
     subsamples : int
         N, the subsamples per rotation-vector update (``rotvec`` only).
-    coefficients : str, optional
+    coefficients : CoefficientName, optional
         Coefficient set; ``None`` is the family's default (``table3`` for ``rotvec``,
         ``derived`` for the rate algorithms; ``rk4`` and the quaternion algorithms have
         none).
-    structure : str
+    structure : StructureName
         Update structure, one the family runs in.
     rk4_step : {"2td", "td-interp"}
         RK4 step variant (``rk4`` only).
@@ -97,11 +119,11 @@ class AlgorithmSpec:
         Quaternion algorithms: exact exponential instead of the truncated series.
     """
 
-    algorithm: str = "rotvec"
+    algorithm: AlgorithmName = "rotvec"
     subsamples: int = 3
-    coefficients: str | None = None
-    structure: str = "conventional"
-    rk4_step: str = "2td"
+    coefficients: CoefficientName | None = None
+    structure: StructureName = "conventional"
+    rk4_step: Rk4Step = "2td"
     alpha: float | None = None
     beta: float | None = None
     step: float | None = None
@@ -130,7 +152,7 @@ class AlgorithmSpec:
         return cls(**fields)
 
     def __str__(self) -> str:
-        parts = [self.algorithm]
+        parts: list[str] = [self.algorithm]
         if "subsamples" in self.family.options:
             parts.append(f"N={self.subsamples}")
         for f in dataclasses.fields(self):
@@ -153,7 +175,7 @@ class AlgorithmSpec:
         return self.family.input_kind
 
     @property
-    def resolved_coefficients(self) -> str | None:
+    def resolved_coefficients(self) -> CoefficientName | None:
         """The coefficient set that runs (the family default when none is given)."""
         return self.coefficients if self.coefficients is not None else (
             self.family.default_coefficients)
@@ -171,12 +193,13 @@ class AlgorithmSpec:
         """The classical-coning drift law, where one is known."""
         return self.family.drift_law(self)
 
-    def propagation(self) -> dict:
+    def propagation(self) -> dict[str, Any]:
         """What the AHRS kernel's propagation step needs (see :mod:`strapdown.ahrs`)."""
         return self.family.propagation(self)
 
     # ------------------------------------------------------------------ running
-    def run(self, record, *, q0=None) -> AttitudeSolution:
+    def run(self, record: GyroRecord | ImuLog, *, q0: ArrayLike | None = None
+            ) -> AttitudeSolution:
         """Run on a gyro record (:class:`~strapdown.truth.sensors.GyroRecord` or
         :class:`~strapdown.io.ImuLog`): attitude ``q_n_b`` from ``q0`` at the first time.
 
@@ -194,18 +217,19 @@ class AlgorithmSpec:
         t0 = float(t[0]) if t.shape[0] == record.data.shape[0] + 1 else float(t[0]) - record.h
         return self.family.run(self, record.data, h=record.h, t0=t0, q0=q0)
 
-    def run_increments(self, increments, *, h: float, t0: float = 0.0,
-                       q0=None) -> AttitudeSolution:
+    def run_increments(self, increments: ArrayLike, *, h: float, t0: float = 0.0,
+                       q0: ArrayLike | None = None) -> AttitudeSolution:
         """Run on angular increments ``(n, 3)`` (rad) every ``h`` seconds from ``t0``."""
         self._need("increment")
         return self.family.run(self, increments, h=h, t0=t0, q0=q0)
 
-    def run_rates(self, t, omega, *, q0=None) -> AttitudeSolution:
+    def run_rates(self, t: ArrayLike, omega: ArrayLike, *, q0: ArrayLike | None = None
+                  ) -> AttitudeSolution:
         """Run on rate samples ``omega`` ``(n, 3)`` (rad/s) at uniform times ``t`` ``(n,)``."""
         self._need("rate")
         return self.family.run(self, omega, h=0.0, t=t, q0=q0)
 
-    def run_mp(self, motion, *, h: float, samples: int, digits: int):
+    def run_mp(self, motion: Motion, *, h: float, samples: int, digits: int) -> MpSolution:
         """Run on a closed-form motion in arbitrary precision (``digits`` significant)."""
         return self.family.run_mp(self, motion, h=h, samples=samples, digits=digits)
 
@@ -215,7 +239,7 @@ class AlgorithmSpec:
                              f"{'increments' if self.input_kind == 'increment' else 'rates'}")
 
 
-def parse_spec(spec: str) -> dict:
+def parse_spec(spec: str) -> dict[str, Any]:
     """``"rotvec:N=3:structure=realtime"`` → ``{"algorithm": "rotvec", "subsamples": 3, ...}``.
 
     Only the fields the string names; :meth:`AlgorithmSpec.parse` validates the whole.
@@ -226,7 +250,7 @@ def parse_spec(spec: str) -> dict:
     if name not in REGISTRY:
         raise ValueError(f"spec {spec!r}: unknown algorithm {name!r}; choose one of "
                          f"{', '.join(ALGORITHMS)}")
-    out: dict = {"algorithm": name}
+    out: dict[str, Any] = {"algorithm": name}
     for o in opts:
         key, eq, value = o.partition("=")
         key = _ALIASES.get(key.strip(), key.strip())
@@ -237,7 +261,7 @@ def parse_spec(spec: str) -> dict:
     return out
 
 
-def _value(spec: str, key: str, value: str):
+def _value(spec: str, key: str, value: str) -> str | int | float | bool:
     try:
         if key in _INT:
             return int(value)

@@ -14,11 +14,14 @@ random chunk sizes).
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from strapdown._core.validation import as_quaternions, as_vectors, finite_array, positive
 from strapdown.algorithms import _kernels
 from strapdown.algorithms.coning import CoefficientSet
+from strapdown.algorithms.family import IncrementStructure
 from strapdown.algorithms.structures import (
+    STRUCTURES,
     AttitudeSolution,
     single_chain_table,
     stack_sets,
@@ -53,9 +56,9 @@ class RotvecStream:
     first N − 1 start-up outputs until N increments have arrived.
     """
 
-    def __init__(self, structure: str, coefficients: CoefficientSet, *, h: float,
-                 t0: float = 0.0, q0=None):
-        if structure not in ("conventional", "realtime", "single-chain"):
+    def __init__(self, structure: IncrementStructure, coefficients: CoefficientSet, *, h: float,
+                 t0: float = 0.0, q0: ArrayLike | None = None) -> None:
+        if structure not in STRUCTURES:
             raise ValueError(f"unknown structure {structure!r}; choose conventional, realtime "
                              "or single-chain")
         if not isinstance(coefficients, CoefficientSet):
@@ -78,7 +81,7 @@ class RotvecStream:
         if structure == "realtime":
             self._ks = stack_sets(startup_sets(coefficients))
         self._buf = _EMPTY  # increments carried over
-        self._qhist: np.ndarray | None = None  # last attitude(s)
+        self._qhist: NDArray[np.float64] | None = None  # last attitude(s)
         self._count = 0  # increments consumed so far
         self._emitted = 0  # outputs emitted so far
 
@@ -88,7 +91,7 @@ class RotvecStream:
         return self._count + self._buf.shape[0] if self.structure == "conventional" else (
             self._count)
 
-    def feed(self, increments) -> AttitudeSolution:
+    def feed(self, increments: ArrayLike) -> AttitudeSolution:
         """Consume a chunk ``(m, 3)``; return the outputs it completes (possibly none)."""
         x = as_vectors(increments, "increments")
         if x.ndim != 2:

@@ -23,8 +23,11 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from fractions import Fraction
+from typing import Literal, get_args
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from strapdown._core.validation import (
     as_quaternions,
@@ -34,11 +37,19 @@ from strapdown._core.validation import (
     positive_int,
 )
 from strapdown.algorithms import _kernels, tables
-from strapdown.algorithms.coning import CoefficientSet, coefficient_set
+from strapdown.algorithms.coning import (
+    CoefficientSet,
+    WindowedAlgorithm,
+    coefficient_set,
+    coning_set_name,
+)
+from strapdown.algorithms.family import IncrementStructure
 
 __all__ = [
     "STRUCTURES",
     "AttitudeSolution",
+    "IncrementStructure",
+    "TailPolicy",
     "chain_rotation_vectors",
     "conventional",
     "realtime",
@@ -47,7 +58,10 @@ __all__ = [
     "windowed",
 ]
 
-STRUCTURES = ("conventional", "realtime", "single-chain")
+#: The update structures of increment input, in the order the command line lists them.
+STRUCTURES: tuple[IncrementStructure, ...] = get_args(IncrementStructure)
+#: What :func:`conventional` does with increments that do not fill a last update.
+TailPolicy = Literal["error", "drop"]
 
 
 @dataclass(frozen=True)
@@ -61,7 +75,9 @@ class AttitudeSolution:
     q : ndarray of shape (m, 4)
         ``q_n_b`` at those times (unit, scalar first).
     structure : str
-        ``"conventional"`` or ``"realtime"``.
+        What produced it: an update structure (``"conventional"``, ``"realtime"``,
+        ``"single-chain"``, ``"sliding"``) or ``"windowed"``, ``"chained"``, ``"rk4"`` or a
+        quaternion algorithm's name.
     coefficients : CoefficientSet or None
         The coning correction used (None for designed/windowed algorithms).
     h : float
@@ -77,13 +93,13 @@ class AttitudeSolution:
         measured from here on.
     """
 
-    t: np.ndarray
-    q: np.ndarray
+    t: NDArray[np.float64]
+    q: NDArray[np.float64]
     structure: str
     coefficients: CoefficientSet | None
     h: float
     update_period: float
-    chain: np.ndarray
+    chain: NDArray[np.int_]
     startup: int = 0
 
     @property
@@ -92,30 +108,32 @@ class AttitudeSolution:
         return int(self.chain.max()) + 1 if self.chain.size else 1
 
 
-def _check_inputs(increments, coefficients, h, q0, t0):
+def _check_inputs(increments: ArrayLike, coefficients: CoefficientSet, h: float,
+                  q0: ArrayLike | None, t0: float
+                  ) -> tuple[NDArray[np.float64], float, NDArray[np.float64], float]:
     if not isinstance(coefficients, CoefficientSet):
         raise ValueError(
             "coefficients must be a CoefficientSet (see "
             "strapdown.algorithms.coning.coefficient_set), "
             f"got {type(coefficients).__name__}"
         )
-    theta, h, t0, q0 = _stream_inputs(increments, "increments", h, t0, q0)
+    theta, h, t0, unit_q0 = _stream_inputs(increments, "increments", h, t0, q0)
     n = coefficients.n
     if theta.shape[0] < n:
         raise ValueError(
             f"N = {n} subsamples need at least {n} increments, got {theta.shape[0]}"
         )
-    return np.ascontiguousarray(theta), h, q0, t0
+    return np.ascontiguousarray(theta), h, unit_q0, t0
 
 
 def conventional(
-    increments,
+    increments: ArrayLike,
     coefficients: CoefficientSet,
     *,
     h: float,
     t0: float = 0.0,
-    q0=None,
-    tail: str = "error",
+    q0: ArrayLike | None = None,
+    tail: TailPolicy = "error",
 ) -> AttitudeSolution:
     """Conventional structure: an attitude update every ``T = N h``.
 
@@ -163,14 +181,14 @@ def startup_sets(coefficients: CoefficientSet) -> list[CoefficientSet]:
     out = []
     for k in range(1, coefficients.n):
         try:
-            out.append(coefficient_set(coefficients.name, k))
+            out.append(coefficient_set(coning_set_name(coefficients.name), k))
         except ValueError:
             out.append(coefficient_set("table3", k))
     out.append(coefficients)
     return out
 
 
-def stack_sets(sets: Sequence[CoefficientSet]) -> np.ndarray:
+def stack_sets(sets: Sequence[CoefficientSet]) -> NDArray[np.float64]:
     """Pack k-subsample matrices into the ``(N, N, N)`` array the real-time kernel reads."""
     n = len(sets)
     ks = np.zeros((n, n, n))
@@ -182,12 +200,12 @@ def stack_sets(sets: Sequence[CoefficientSet]) -> np.ndarray:
 
 
 def realtime(
-    increments,
+    increments: ArrayLike,
     coefficients: CoefficientSet,
     *,
     h: float,
     t0: float = 0.0,
-    q0=None,
+    q0: ArrayLike | None = None,
     startup: Sequence[CoefficientSet] | None = None,
 ) -> AttitudeSolution:
     """Li & Zhang 2017 real-time structure (eq. 15): an output every ``h``.
@@ -215,8 +233,10 @@ def realtime(
     return AttitudeSolution(t0 + k * h, q, "realtime", coefficients, h, h, k % n)
 
 
-def run_structure(name: str, increments, coefficients, *, h, t0=0.0, q0=None) -> AttitudeSolution:
-    """Dispatch by structure name (``"conventional"`` or ``"realtime"``).
+def run_structure(name: IncrementStructure, increments: ArrayLike,
+                  coefficients: CoefficientSet, *, h: float, t0: float = 0.0,
+                  q0: ArrayLike | None = None) -> AttitudeSolution:
+    """Dispatch by structure name (``"conventional"``, ``"realtime"`` or ``"single-chain"``).
 
     The conventional structure drops a tail of fewer than N increments here
     (``tail="drop"``); call :func:`conventional` directly to have it refused.
@@ -236,8 +256,9 @@ def run_structure(name: str, increments, coefficients, *, h, t0=0.0, q0=None) ->
     raise ValueError(f"unknown structure {name!r}; choose one of {', '.join(STRUCTURES)}")
 
 
-def windowed(samples, algorithm, *, h: float, t0: float = 0.0, q0=None,
-             sliding: bool = False, startup=None) -> AttitudeSolution:
+def windowed(samples: ArrayLike, algorithm: WindowedAlgorithm, *, h: float, t0: float = 0.0,
+             q0: ArrayLike | None = None, sliding: bool = False,
+             startup: WindowedAlgorithm | None = None) -> AttitudeSolution:
     """Run a :class:`~strapdown.algorithms.coning.WindowedAlgorithm` on a sample stream.
 
     Sample ``k`` is the increment over ``[t0 + k h, t0 + (k+1) h]`` or the rate
@@ -250,15 +271,15 @@ def windowed(samples, algorithm, *, h: float, t0: float = 0.0, q0=None,
     from ``startup`` (a one-sample WindowedAlgorithm, e.g. the single-period
     rate algorithm) chained from ``q0``. That is ``U`` interleaved chains.
     """
-    from strapdown.algorithms.coning import WindowedAlgorithm
-
     if not isinstance(algorithm, WindowedAlgorithm):
         raise ValueError(f"algorithm must be a WindowedAlgorithm, got {type(algorithm).__name__}")
     x, h, t0, q0 = _stream_inputs(samples, "samples", h, t0, q0)
     return _windowed(np.ascontiguousarray(x), algorithm, h, t0, q0, sliding, startup)
 
 
-def _windowed(x, algorithm, h, t0, q0, sliding, startup) -> AttitudeSolution:
+def _windowed(x: NDArray[np.float64], algorithm: WindowedAlgorithm, h: float, t0: float,
+              q0: NDArray[np.float64], sliding: bool,
+              startup: WindowedAlgorithm | None) -> AttitudeSolution:
     """:func:`windowed` on inputs already validated (C-contiguous float64, unit q0)."""
     b0 = algorithm.history
     last = x.shape[0] - 1 - algorithm.span  # largest admissible update start
@@ -289,7 +310,8 @@ def _windowed(x, algorithm, h, t0, q0, sliding, startup) -> AttitudeSolution:
     return AttitudeSolution(t, q, "sliding", None, h, h, chain)
 
 
-def _run_windowed(x, algorithm, h, b0, step, stride, q):
+def _run_windowed(x: NDArray[np.float64], algorithm: WindowedAlgorithm, h: float, b0: int,
+                  step: int, stride: int, q: NDArray[np.float64]) -> None:
     """Fused kernel call for a WindowedAlgorithm: the update starting at sample
     ``b0 + r·step`` writes ``q[r + stride]`` from ``q[r]``, for every row after ``q[:stride]``
     (rates scale α by h and β by h²).
@@ -316,7 +338,7 @@ def _run_windowed(x, algorithm, h, b0, step, stride, q):
                              stride, q)
 
 
-def single_chain_coefficients(n: int) -> tuple:
+def single_chain_coefficients(n: int) -> tuple[Fraction, ...]:
     """Exact single-chain coefficients ``c_1 … c_{N−1}`` (classical-coning optimum, designer;
     tabulated in :data:`strapdown.algorithms.tables.SINGLE_CHAIN`)."""
     n = positive_int(n, "N (subsamples)")
@@ -326,7 +348,7 @@ def single_chain_coefficients(n: int) -> tuple:
     return tables.SINGLE_CHAIN[n]
 
 
-def single_chain_table(n: int) -> np.ndarray:
+def single_chain_table(n: int) -> NDArray[np.float64]:
     """Start-up and steady coefficients, shape (N, N − 1): row m holds c_1 … c_m of the
     (m+1)-sample single-chain set (row N − 1 is the steady set)."""
     n = positive_int(n, "N (subsamples)")
@@ -336,7 +358,8 @@ def single_chain_table(n: int) -> np.ndarray:
     return c
 
 
-def single_chain(increments, n: int, *, h: float, t0: float = 0.0, q0=None) -> AttitudeSolution:
+def single_chain(increments: ArrayLike, n: int, *, h: float, t0: float = 0.0,
+                 q0: ArrayLike | None = None) -> AttitudeSolution:
     """Single-chain high-rate structure: an attitude every h with N-subsample accuracy.
 
     ``φ_k = θ_k + Σ_{m=1}^{N−1} c_m θ_{k−m} × θ_k``, ``q_k = q_{k−1} ⊗ q(φ_k)``,
@@ -361,7 +384,8 @@ def single_chain(increments, n: int, *, h: float, t0: float = 0.0, q0=None) -> A
                             min(n - 1, t.size - 1))
 
 
-def _stream_inputs(samples, name, h, t0, q0):
+def _stream_inputs(samples: ArrayLike, name: str, h: float, t0: float, q0: ArrayLike | None
+                   ) -> tuple[NDArray[np.float64], float, float, NDArray[np.float64]]:
     """Validated (samples (n, 3), h, t0, unit q0) of a sample-stream call."""
     x = as_vectors(samples, name)
     if x.ndim != 2:
@@ -370,7 +394,7 @@ def _stream_inputs(samples, name, h, t0, q0):
             _unit_q0(q0))
 
 
-def _unit_q0(q0) -> np.ndarray:
+def _unit_q0(q0: ArrayLike | None) -> NDArray[np.float64]:
     if q0 is None:
         return np.array([1.0, 0.0, 0.0, 0.0])
     q0 = as_quaternions(q0, "q0")
@@ -379,8 +403,8 @@ def _unit_q0(q0) -> np.ndarray:
     return q0 / np.linalg.norm(q0)
 
 
-def chain_rotation_vectors(phi, *, update_period: float, t0: float = 0.0,
-                           q0=None) -> AttitudeSolution:
+def chain_rotation_vectors(phi: ArrayLike, *, update_period: float, t0: float = 0.0,
+                           q0: ArrayLike | None = None) -> AttitudeSolution:
     """Chain precomputed body rotation vectors: ``q_k = q_{k−1} ⊗ q(φ_k)``."""
     phi = as_vectors(phi, "phi")
     if phi.ndim != 2:

@@ -12,6 +12,8 @@ from __future__ import annotations
 
 from fractions import Fraction as F
 
+from strapdown.algorithms.family import RateCoefficients, Rk4Step
+
 __all__ = [
     "RATE_SINGLE",
     "RATE_SINGLE_DRIFT",
@@ -35,8 +37,9 @@ SINGLE_CHAIN: dict[int, tuple[F, ...]] = {
 #: Single-period rate algorithm ΔΦ = td/2 (ω₀ + ω₁) + c td² ω₀ × ω₁: the cross-product
 #: coefficient c. ``derived``: ``derive(rate_structure(1))`` (quadrature error included);
 #: ``paper``: Wang, Wang & Wang's start-up form.
-RATE_SINGLE: dict[str, F] = {"derived": F(1, 6), "paper": F(1, 12)}
-RATE_SINGLE_DRIFT: dict[str, tuple[int, F]] = {"derived": (4, F(11, 1440)), "paper": (2, F(1, 12))}
+RATE_SINGLE: dict[RateCoefficients, F] = {"derived": F(1, 6), "paper": F(1, 12)}
+RATE_SINGLE_DRIFT: dict[RateCoefficients, tuple[int, F]] = {"derived": (4, F(11, 1440)),
+                                                             "paper": (2, F(1, 12))}
 
 #: Three-period rate algorithm on ω at 0, td, 2td, 3td: pair coefficients k_ij (in units of
 #: td²) for the pairs (0,1), (0,2), (0,3), (1,2), (1,3), (2,3); the quadrature weights are
@@ -45,13 +48,13 @@ RATE_SINGLE_DRIFT: dict[str, tuple[int, F]] = {"derived": (4, F(11, 1440)), "pap
 #: (``quadrature=False``), Wang, Wang & Wang's derivation as reconstructed.
 RATE_THREE_PAIRS: tuple[tuple[int, int], ...] = ((0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3))
 RATE_THREE_WEIGHTS: tuple[F, ...] = (F(3, 8), F(9, 8), F(9, 8), F(3, 8))
-RATE_THREE: dict[str, tuple[F, ...]] = {
+RATE_THREE: dict[RateCoefficients, tuple[F, ...]] = {
     "derived": (F(719, 1680), F(103, 560), F(43, 560), F(719, 1680), F(103, 560), F(719, 1680)),
     "paper": (F(873, 2240), F(27, 112), F(87, 2240), F(873, 2240), F(27, 112), F(873, 2240)),
 }
-RATE_THREE_DRIFT: dict[str, tuple[int, F]] = {"derived": (8, F(433, 806400)),
-                                              "paper": (4, F(-1, 80))}
+RATE_THREE_DRIFT: dict[RateCoefficients, tuple[int, F]] = {"derived": (8, F(433, 806400)),
+                                                            "paper": (4, F(-1, 80))}
 
 #: Quaternion RK4 on q̇ = ½ q ⊗ ω: (order, c) per step variant, derived symbolically by
 #: :func:`strapdown.design.rk4_classical_coning_drift`.
-RK4_DRIFT: dict[str, tuple[int, F]] = {"2td": (4, F(-1, 60)), "td-interp": (2, F(1, 12))}
+RK4_DRIFT: dict[Rk4Step, tuple[int, F]] = {"2td": (4, F(-1, 60)), "td-interp": (2, F(1, 12))}
