@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 #: Below this angle argument x (rad), ``sin(x)/x`` uses its Taylor series
 #: (terms to x⁶; the first omitted term x⁸/9! is below 3e-22 relative) and the
@@ -12,7 +13,7 @@ import numpy as np
 SMALL_ANGLE = 1e-2
 
 
-def sinc(x: np.ndarray) -> np.ndarray:
+def sinc(x: ArrayLike) -> NDArray[np.float64]:
     """``sin(x)/x`` (unnormalised), exact at 0, series below :data:`SMALL_ANGLE`."""
     x = np.asarray(x, dtype=np.float64)
     small = np.abs(x) < SMALL_ANGLE

@@ -7,6 +7,7 @@ message names the argument and the problem (shape, NaN, sign, ordering).
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 __all__ = [
     "as_dcms",
@@ -20,7 +21,7 @@ __all__ = [
 ]
 
 
-def finite_array(x, name: str) -> np.ndarray:
+def finite_array(x: ArrayLike, name: str) -> NDArray[np.float64]:
     """Return ``x`` as float64, raising if it holds NaN or infinity."""
     try:
         a = np.asarray(x, dtype=np.float64)
@@ -33,7 +34,8 @@ def finite_array(x, name: str) -> np.ndarray:
     return a
 
 
-def _trailing(x, name: str, trailing: tuple[int, ...], label: str) -> np.ndarray:
+def _trailing(x: ArrayLike, name: str, trailing: tuple[int, ...], label: str
+              ) -> NDArray[np.float64]:
     a = finite_array(x, name)
     k = len(trailing)
     if a.ndim < k or a.shape[a.ndim - k :] != trailing:
@@ -42,12 +44,12 @@ def _trailing(x, name: str, trailing: tuple[int, ...], label: str) -> np.ndarray
     return a
 
 
-def as_vectors(x, name: str = "vector") -> np.ndarray:
+def as_vectors(x: ArrayLike, name: str = "vector") -> NDArray[np.float64]:
     """3-vectors, shape ``(..., 3)``."""
     return _trailing(x, name, (3,), "3-vectors")
 
 
-def as_quaternions(x, name: str = "quaternion") -> np.ndarray:
+def as_quaternions(x: ArrayLike, name: str = "quaternion") -> NDArray[np.float64]:
     """Scalar-first quaternions, shape ``(..., 4)``; non-zero norm required."""
     q = _trailing(x, name, (4,), "scalar-first quaternions")
     n = np.linalg.norm(q, axis=-1)
@@ -56,12 +58,12 @@ def as_quaternions(x, name: str = "quaternion") -> np.ndarray:
     return q
 
 
-def as_dcms(x, name: str = "dcm") -> np.ndarray:
+def as_dcms(x: ArrayLike, name: str = "dcm") -> NDArray[np.float64]:
     """Direction cosine matrices, shape ``(..., 3, 3)``."""
     return _trailing(x, name, (3, 3), "direction cosine matrices")
 
 
-def as_times(t, name: str = "t", *, min_len: int = 1) -> np.ndarray:
+def as_times(t: ArrayLike, name: str = "t", *, min_len: int = 1) -> NDArray[np.float64]:
     """Strictly increasing 1-D time stamps."""
     a = finite_array(t, name)
     if a.ndim != 1:
@@ -79,7 +81,7 @@ def as_times(t, name: str = "t", *, min_len: int = 1) -> np.ndarray:
     return a
 
 
-def first_bad_step(d: np.ndarray) -> tuple[int, str] | None:
+def first_bad_step(d: NDArray[np.float64]) -> tuple[int, str] | None:
     """First non-positive time step in ``d = diff(t)``: ``(i, "duplicated" | "non-monotonic")``,
     so that ``t[i + 1]`` does not exceed ``t[i]``; ``None`` if ``t`` strictly increases."""
     bad = d <= 0
@@ -89,10 +91,10 @@ def first_bad_step(d: np.ndarray) -> tuple[int, str] | None:
     return i, "duplicated" if d[i] == 0 else "non-monotonic"
 
 
-def positive(x, name: str) -> float:
+def positive(x: object, name: str) -> float:
     """A finite, strictly positive scalar."""
     try:
-        v = float(x)
+        v = float(x)  # type: ignore[arg-type]  # any object: float() decides (TypeError below)
     except (TypeError, ValueError) as exc:
         raise ValueError(f"{name} must be a positive number, got {x!r}") from exc
     if not np.isfinite(v) or v <= 0.0:
@@ -100,7 +102,7 @@ def positive(x, name: str) -> float:
     return v
 
 
-def positive_int(x, name: str) -> int:
+def positive_int(x: object, name: str) -> int:
     """A strictly positive integer (bools rejected)."""
     if isinstance(x, bool) or not isinstance(x, int | np.integer):
         raise ValueError(f"{name} must be a positive integer, got {x!r}")

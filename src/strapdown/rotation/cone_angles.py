@@ -21,6 +21,7 @@ give the negative of the z-y-x pitch and a wrong yaw beyond δ2 = 90°.
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from strapdown._core.validation import as_dcms, as_quaternions, finite_array
 from strapdown.rotation.dcm import dcm_from_quat, quat_from_dcm
@@ -37,19 +38,20 @@ __all__ = [
 _TWO_PI = 2.0 * np.pi
 
 
-def dcm_from_cone_angles(d1, d2, d3) -> np.ndarray:
+def dcm_from_cone_angles(d1: ArrayLike, d2: ArrayLike, d3: ArrayLike) -> NDArray[np.float64]:
     """``C_c_b = Rx(δ1) Rz(δ2) Rx(δ3 − δ1)``: Zhang & Yu eq. 4 transposed, eq. 2 corrected."""
     d1, d2, d3 = np.broadcast_arrays(finite_array(d1, "delta1"), finite_array(d2, "delta2"),
                                      finite_array(d3, "delta3"))
     return _rx(d1) @ _rz(d2) @ _rx(d3 - d1)
 
 
-def quat_from_cone_angles(d1, d2, d3) -> np.ndarray:
+def quat_from_cone_angles(d1: ArrayLike, d2: ArrayLike, d3: ArrayLike) -> NDArray[np.float64]:
     """``q_c_b`` of the cone angles (w ≥ 0)."""
     return quat_from_dcm(dcm_from_cone_angles(d1, d2, d3))
 
 
-def cone_angles_from_dcm(dcm) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def cone_angles_from_dcm(dcm: ArrayLike
+                         ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """(δ1, δ2, δ3) from ``C_c_b``, robust at δ2 = 0 and δ2 = π (see module docstring)."""
     c = as_dcms(dcm, "dcm")
     s2 = np.hypot(c[..., 1, 0], c[..., 2, 0])
@@ -61,12 +63,15 @@ def cone_angles_from_dcm(dcm) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return d1, d2, np.mod(d3, _TWO_PI)
 
 
-def cone_angles_from_quat(q) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def cone_angles_from_quat(q: ArrayLike
+                          ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """(δ1, δ2, δ3) from ``q_c_b``."""
     return cone_angles_from_dcm(dcm_from_quat(as_quaternions(q, "q")))
 
 
-def pitch_yaw_roll_from_cone_angles(d1, d2, d3) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def pitch_yaw_roll_from_cone_angles(
+    d1: ArrayLike, d2: ArrayLike, d3: ArrayLike
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """z-y-x (yaw, pitch, roll) of the same attitude, through the DCM (valid for every δ2)."""
     return euler_zyx_from_dcm(dcm_from_cone_angles(d1, d2, d3))
 

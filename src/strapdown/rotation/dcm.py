@@ -3,17 +3,18 @@
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from strapdown._core.validation import as_dcms, as_quaternions
 
 __all__ = ["dcm_from_quat", "quat_from_dcm"]
 
 
-def dcm_from_quat(q) -> np.ndarray:
+def dcm_from_quat(q: ArrayLike) -> NDArray[np.float64]:
     """``C_n_b`` from ``q_n_b`` (normalised first), shape ``(..., 3, 3)``."""
-    q = as_quaternions(q, "q")
-    q = q / np.linalg.norm(q, axis=-1, keepdims=True)
-    w, x, y, z = np.moveaxis(q, -1, 0)
+    u = as_quaternions(q, "q")
+    u = u / np.linalg.norm(u, axis=-1, keepdims=True)
+    w, x, y, z = np.moveaxis(u, -1, 0)
     return np.stack(
         [
             np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
@@ -24,7 +25,7 @@ def dcm_from_quat(q) -> np.ndarray:
     )
 
 
-def quat_from_dcm(dcm) -> np.ndarray:
+def quat_from_dcm(dcm: ArrayLike) -> NDArray[np.float64]:
     """``q_n_b`` from ``C_n_b`` by Shepperd's method (largest-pivot branch).
 
     Returns the representative with ``w >= 0``. The input is assumed

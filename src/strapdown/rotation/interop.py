@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
 from strapdown._core.validation import as_quaternions
@@ -10,7 +11,7 @@ from strapdown._core.validation import as_quaternions
 __all__ = ["quat_from_scipy", "scipy_from_quat"]
 
 
-def scipy_from_quat(q) -> Rotation:
+def scipy_from_quat(q: ArrayLike) -> Rotation:
     """A scipy ``Rotation`` holding ``q_n_b`` (shape ``(4,)`` or ``(n, 4)``)."""
     q = as_quaternions(q, "q")
     if q.ndim > 2:
@@ -18,7 +19,7 @@ def scipy_from_quat(q) -> Rotation:
     return Rotation.from_quat(q, scalar_first=True)
 
 
-def quat_from_scipy(rotation: Rotation) -> np.ndarray:
+def quat_from_scipy(rotation: Rotation) -> NDArray[np.float64]:
     """Scalar-first quaternion(s) of a scipy ``Rotation``."""
     if not isinstance(rotation, Rotation):
         raise ValueError(f"rotation must be a scipy Rotation, got {type(rotation).__name__}")

@@ -6,6 +6,7 @@ All functions broadcast over leading dimensions ``(..., 4)``.
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from strapdown._core.series import SMALL_ANGLE, sinc
 from strapdown._core.validation import as_quaternions, as_vectors
@@ -22,14 +23,14 @@ __all__ = [
 ]
 
 
-def quat_identity(shape: tuple[int, ...] = ()) -> np.ndarray:
+def quat_identity(shape: tuple[int, ...] = ()) -> NDArray[np.float64]:
     """Identity quaternions of the given batch shape, ``shape + (4,)``."""
     q = np.zeros((*shape, 4))
     q[..., 0] = 1.0
     return q
 
 
-def quat_multiply(p, q) -> np.ndarray:
+def quat_multiply(p: ArrayLike, q: ArrayLike) -> NDArray[np.float64]:
     """Hamilton product ``p ⊗ q`` (broadcast over leading dimensions)."""
     p = as_quaternions(p, "p")
     q = as_quaternions(q, "q")
@@ -46,19 +47,19 @@ def quat_multiply(p, q) -> np.ndarray:
     )
 
 
-def quat_conjugate(q) -> np.ndarray:
+def quat_conjugate(q: ArrayLike) -> NDArray[np.float64]:
     """Conjugate ``q*`` (the inverse of a unit quaternion)."""
     q = as_quaternions(q, "q")
     return q * np.array([1.0, -1.0, -1.0, -1.0])
 
 
-def quat_normalize(q) -> np.ndarray:
+def quat_normalize(q: ArrayLike) -> NDArray[np.float64]:
     """Unit quaternion with the same attitude."""
     q = as_quaternions(q, "q")
     return q / np.linalg.norm(q, axis=-1, keepdims=True)
 
 
-def quat_canonical(q) -> np.ndarray:
+def quat_canonical(q: ArrayLike) -> NDArray[np.float64]:
     """Representative with ``w >= 0`` (ties broken on the first non-zero component).
 
     ``q`` and ``-q`` are the same attitude; this picks one so that arrays can be
@@ -75,7 +76,7 @@ def quat_canonical(q) -> np.ndarray:
     return q * sign[..., None]
 
 
-def quat_rotate(q, v) -> np.ndarray:
+def quat_rotate(q: ArrayLike, v: ArrayLike) -> NDArray[np.float64]:
     """Rotate body vectors into the reference frame: ``v_n = q ⊗ [0, v_b] ⊗ q*``.
 
     ``q`` need not be unit; it is normalised first.
@@ -88,7 +89,7 @@ def quat_rotate(q, v) -> np.ndarray:
     return v + w * t + np.cross(u, t)
 
 
-def quat_from_rotvec(rotvec) -> np.ndarray:
+def quat_from_rotvec(rotvec: ArrayLike) -> NDArray[np.float64]:
     """Exponential map ``q(φ) = [cos(|φ|/2), sin(|φ|/2) φ/|φ|]``.
 
     Exact for every angle; ``sin(|φ|/2)/|φ|`` uses its series below
@@ -103,7 +104,7 @@ def quat_from_rotvec(rotvec) -> np.ndarray:
     return np.concatenate([w[..., None], s[..., None] * phi], axis=-1)
 
 
-def rotvec_from_quat(q) -> np.ndarray:
+def rotvec_from_quat(q: ArrayLike) -> NDArray[np.float64]:
     """Logarithm map: the rotation vector with ``|φ| ∈ [0, π]``.
 
     Uses ``|φ| = 2 atan2(|v|, |w|)`` with the sign of ``w`` folded into the

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from strapdown._core.series import sinc
 from strapdown._core.validation import as_vectors
@@ -10,7 +11,7 @@ from strapdown._core.validation import as_vectors
 __all__ = ["dcm_from_rotvec", "f1_f2", "skew"]
 
 
-def skew(v) -> np.ndarray:
+def skew(v: ArrayLike) -> NDArray[np.float64]:
     """Cross-product matrix ``(v×)`` so that ``skew(v) @ u == cross(v, u)``; ``(..., 3, 3)``."""
     v = as_vectors(v, "v")
     x, y, z = np.moveaxis(v, -1, 0)
@@ -25,7 +26,7 @@ def skew(v) -> np.ndarray:
     )
 
 
-def f1_f2(angle) -> tuple[np.ndarray, np.ndarray]:
+def f1_f2(angle: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """``f1 = sin|φ|/|φ|`` and ``f2 = (1 − cos|φ|)/|φ|²`` (Li & Zhang 2017 eq. 9).
 
     ``f2`` is evaluated as ``½ (sin(|φ|/2)/(|φ|/2))²``, which is the same
@@ -37,7 +38,7 @@ def f1_f2(angle) -> tuple[np.ndarray, np.ndarray]:
     return f1, f2
 
 
-def dcm_from_rotvec(rotvec) -> np.ndarray:
+def dcm_from_rotvec(rotvec: ArrayLike) -> NDArray[np.float64]:
     """``C = I + f1 (φ×) + f2 (φ×)²`` (Li & Zhang 2017 eq. 9), shape ``(..., 3, 3)``.
 
     For an interval's body rotation vector this is ``C_b(k-1)_b(k)``.
