@@ -24,6 +24,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from strapdown._core.backend import MPMATH, NUMPY, Backend
 from strapdown._core.validation import as_quaternions, as_times, as_vectors, finite_array, positive
@@ -46,6 +47,9 @@ QUADRATURE_NODES = 12
 
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(QUADRATURE_NODES)
 
+#: A user function of time: float64 times in, values of shape ``t.shape + (k,)`` out.
+TimeFunction = Callable[[NDArray[np.float64]], ArrayLike]
+
 
 class Motion(abc.ABC):
     """A rigid-body rotation with exact truth.
@@ -59,23 +63,23 @@ class Motion(abc.ABC):
         (the cone period); ``None`` for aperiodic motions.
     """
 
-    cone_axis: np.ndarray | None = None
+    cone_axis: NDArray[np.float64] | None = None
     period: float | None = None
 
     @abc.abstractmethod
-    def attitude(self, t) -> np.ndarray:
+    def attitude(self, t: ArrayLike) -> NDArray[np.float64]:
         """``q_n_b(t)`` for time(s) ``t``, shape ``t.shape + (4,)``."""
 
     @abc.abstractmethod
-    def rate(self, t) -> np.ndarray:
+    def rate(self, t: ArrayLike) -> NDArray[np.float64]:
         """Body rate ``ω_b(t)`` (rad/s), shape ``t.shape + (3,)``."""
 
-    def increments(self, edges) -> np.ndarray:
+    def increments(self, edges: ArrayLike) -> NDArray[np.float64]:
         """Exact angular increments over consecutive ``edges``, shape ``(n - 1, 3)``."""
-        edges = as_times(edges, "edges", min_len=2)
-        return self._increments(edges[:-1], edges[1:])
+        e = as_times(edges, "edges", min_len=2)
+        return self._increments(e[:-1], e[1:])
 
-    def _increments(self, t0: np.ndarray, t1: np.ndarray) -> np.ndarray:
+    def _increments(self, t0: NDArray[np.float64], t1: NDArray[np.float64]) -> NDArray[np.float64]:
         mid = 0.5 * (t0 + t1)
         half = 0.5 * (t1 - t0)
         nodes = mid[:, None] + half[:, None] * _GL_X[None, :]
@@ -120,15 +124,15 @@ class _ClosedForm(Motion):
     @abc.abstractmethod
     def _rate(self, m: Backend, t) -> tuple: ...
 
-    def attitude(self, t) -> np.ndarray:
+    def attitude(self, t: ArrayLike) -> NDArray[np.float64]:
         t = finite_array(t, "t")
         return np.stack(np.broadcast_arrays(*self._attitude(NUMPY, t)), axis=-1)
 
-    def rate(self, t) -> np.ndarray:
+    def rate(self, t: ArrayLike) -> NDArray[np.float64]:
         t = finite_array(t, "t")
         return np.stack(np.broadcast_arrays(*self._rate(NUMPY, t)), axis=-1)
 
-    def _increments(self, t0, t1) -> np.ndarray:
+    def _increments(self, t0: NDArray[np.float64], t1: NDArray[np.float64]) -> NDArray[np.float64]:
         # Anchored at the exact start edge t0 with the exact width t1 − t0 (Sterbenz),
         # phases formed by exact products: no rounded midpoint, no lost phase.
         parts = self._increment(NUMPY, t0, t1 - t0)
@@ -162,7 +166,7 @@ class _ConingAboutX(_ClosedForm):
             raise ValueError(f"cone_rate must be finite and non-zero, got {self.cone_rate!r}")
 
     @property
-    def cone_axis(self) -> np.ndarray:  # type: ignore[override]
+    def cone_axis(self) -> NDArray[np.float64]:  # type: ignore[override]
         return np.array([1.0, 0.0, 0.0])
 
 
@@ -388,12 +392,12 @@ class UserMotion(Motion):
 
     def __init__(
         self,
-        attitude: Callable[[np.ndarray], np.ndarray],
-        rate: Callable[[np.ndarray], np.ndarray],
+        attitude: TimeFunction,
+        rate: TimeFunction,
         *,
         period: float | None = None,
-        cone_axis=None,
-    ):
+        cone_axis: ArrayLike | None = None,
+    ) -> None:
         if not callable(attitude) or not callable(rate):
             raise ValueError("attitude and rate must be callables of time")
         self._attitude_fn = attitude
@@ -405,14 +409,14 @@ class UserMotion(Motion):
                 raise ValueError("cone_axis must be a non-zero vector of shape (3,)")
             self.cone_axis = ax / np.linalg.norm(ax)
 
-    def attitude(self, t) -> np.ndarray:
+    def attitude(self, t: ArrayLike) -> NDArray[np.float64]:
         t = finite_array(t, "t")
         q = as_quaternions(self._attitude_fn(t), "attitude(t)")
         if q.shape != (*t.shape, 4):
             raise ValueError(f"attitude(t) must have shape {(*t.shape, 4)}, got {q.shape}")
         return q
 
-    def rate(self, t) -> np.ndarray:
+    def rate(self, t: ArrayLike) -> NDArray[np.float64]:
         t = finite_array(t, "t")
         w = as_vectors(self._rate_fn(t), "rate(t)")
         if w.shape != (*t.shape, 3):
@@ -462,7 +466,9 @@ class ConeAngleMotion(Motion):
         ``t → (..., 3)`` (δ1, δ2, δ3) and their time derivatives (rad, rad/s).
     """
 
-    def __init__(self, angles, angle_rates, *, period=None, cone_axis=(1.0, 0.0, 0.0)):
+    def __init__(self, angles: TimeFunction,
+                 angle_rates: TimeFunction, *, period: float | None = None,
+                 cone_axis: ArrayLike | None = (1.0, 0.0, 0.0)) -> None:
         if not callable(angles) or not callable(angle_rates):
             raise ValueError("angles and angle_rates must be callables of time")
         self._d = angles
@@ -471,8 +477,8 @@ class ConeAngleMotion(Motion):
         self.cone_axis = None if cone_axis is None else as_vectors(cone_axis, "cone_axis")
 
     @classmethod
-    def polynomial(cls, start=(0.0, 0.0, 0.0), rates=(0.0, 0.0, 0.0),
-                   accelerations=(0.0, 0.0, 0.0)) -> ConeAngleMotion:
+    def polynomial(cls, start: ArrayLike = (0.0, 0.0, 0.0), rates: ArrayLike = (0.0, 0.0, 0.0),
+                   accelerations: ArrayLike = (0.0, 0.0, 0.0)) -> ConeAngleMotion:
         """δ_i(t) = start_i + rate_i t + ½ accel_i t² (Zhang & Yu Tables 5–6), rad."""
         d0 = as_vectors(start, "start")
         r = as_vectors(rates, "rates")
@@ -488,7 +494,7 @@ class ConeAngleMotion(Motion):
 
         return cls(angles, angle_rates)
 
-    def angles(self, t) -> np.ndarray:
+    def angles(self, t: ArrayLike) -> NDArray[np.float64]:
         """(δ1, δ2, δ3) at ``t``, shape ``t.shape + (3,)``."""
         t = finite_array(t, "t")
         d = as_vectors(self._d(t), "angles(t)")
@@ -496,7 +502,7 @@ class ConeAngleMotion(Motion):
             raise ValueError(f"angles(t) must have shape {(*t.shape, 3)}, got {d.shape}")
         return d
 
-    def attitude(self, t) -> np.ndarray:
+    def attitude(self, t: ArrayLike) -> NDArray[np.float64]:
         d = self.angles(t)
         d1, d2, d3 = d[..., 0], d[..., 1], d[..., 2]
         qx1 = np.stack([np.cos(d1 / 2), np.sin(d1 / 2), 0 * d1, 0 * d1], -1)
@@ -504,7 +510,7 @@ class ConeAngleMotion(Motion):
         qx3 = np.stack([np.cos((d3 - d1) / 2), np.sin((d3 - d1) / 2), 0 * d1, 0 * d1], -1)
         return quat_multiply(quat_multiply(qx1, qz), qx3)
 
-    def rate(self, t) -> np.ndarray:
+    def rate(self, t: ArrayLike) -> NDArray[np.float64]:
         """Eq. 6: ω = (δ̇1(cos δ2 − 1) + δ̇3, −δ̇1 cos e sin δ2 − δ̇2 sin e,
         −δ̇1 sin e sin δ2 + δ̇2 cos e), e = δ1 − δ3."""
         d = self.angles(t)
@@ -542,7 +548,9 @@ class RotationSequenceMotion(Motion):
         Reference-frame cone axis, if the motion cones.
     """
 
-    def __init__(self, axes: str, angles, angle_rates, *, period=None, cone_axis=None):
+    def __init__(self, axes: str, angles: TimeFunction,
+                 angle_rates: TimeFunction, *, period: float | None = None,
+                 cone_axis: ArrayLike | None = None) -> None:
         if not isinstance(axes, str) or len(axes) != 3 or any(c not in _AXES for c in axes):
             raise ValueError(f"axes must be three of 'x', 'y', 'z' (e.g. 'zyx'), got {axes!r}")
         if not callable(angles) or not callable(angle_rates):
@@ -556,7 +564,7 @@ class RotationSequenceMotion(Motion):
             ax = as_vectors(cone_axis, "cone_axis")
             self.cone_axis = ax / np.linalg.norm(ax)
 
-    def _axis_quats(self, ang: np.ndarray) -> list[np.ndarray]:
+    def _axis_quats(self, ang: NDArray[np.float64]) -> list[NDArray[np.float64]]:
         out = []
         for k, i in enumerate(self._idx):
             q = np.zeros((*ang.shape[:-1], 4))
@@ -565,18 +573,18 @@ class RotationSequenceMotion(Motion):
             out.append(q)
         return out
 
-    def _eval(self, t, fn, name):
+    def _eval(self, t: ArrayLike, fn: TimeFunction, name: str) -> NDArray[np.float64]:
         t = finite_array(t, "t")
         v = as_vectors(fn(t), name)
         if v.shape != (*t.shape, 3):
             raise ValueError(f"{name} must have shape {(*t.shape, 3)}, got {v.shape}")
         return v
 
-    def attitude(self, t) -> np.ndarray:
+    def attitude(self, t: ArrayLike) -> NDArray[np.float64]:
         q1, q2, q3 = self._axis_quats(self._eval(t, self._angles, "angles(t)"))
         return quat_multiply(quat_multiply(q1, q2), q3)
 
-    def rate(self, t) -> np.ndarray:
+    def rate(self, t: ArrayLike) -> NDArray[np.float64]:
         ang = self._eval(t, self._angles, "angles(t)")
         dang = self._eval(t, self._angle_rates, "angle_rates(t)")
         _, q2, q3 = self._axis_quats(ang)

@@ -7,10 +7,13 @@ rates; :class:`GyroErrors` corrupts them reproducibly from a seed or a
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
+from strapdown._core.kinds import InputKind
 from strapdown._core.validation import finite_array, positive, positive_int
 from strapdown.truth.motions import Motion
 
@@ -19,12 +22,18 @@ __all__ = [
     "GyroErrors",
     "GyroRecord",
     "MagnetometerErrors",
+    "RngLike",
     "accelerometer",
     "increments",
     "magnetometer",
     "preaveraged_increments",
     "rate_samples",
 ]
+
+
+#: What seeds the sensor noise: anything :func:`numpy.random.default_rng` takes.
+RngLike = int | Sequence[int] | np.random.SeedSequence | np.random.BitGenerator | (
+    np.random.Generator) | None
 
 
 @dataclass(frozen=True)
@@ -41,13 +50,13 @@ class GyroRecord:
         Sample interval (s).
     """
 
-    t: np.ndarray
-    data: np.ndarray
-    kind: str
+    t: NDArray[np.float64]
+    data: NDArray[np.float64]
+    kind: InputKind
     h: float
 
 
-def _vec3(x, name):
+def _vec3(x: ArrayLike, name: str) -> NDArray[np.float64]:
     a = finite_array(x, name)
     if a.shape == ():
         a = np.full(3, float(a))
@@ -89,11 +98,11 @@ class GyroErrors:
     """
 
     white_noise: float = 0.0
-    bias: float | np.ndarray = 0.0
-    gm_sigma: float | np.ndarray = 0.0
+    bias: float | NDArray[np.float64] = 0.0
+    gm_sigma: float | NDArray[np.float64] = 0.0
     gm_tau: float = np.inf
-    scale_factor: float | np.ndarray = 0.0
-    misalignment: np.ndarray = field(default_factory=lambda: np.zeros((3, 3)))
+    scale_factor: float | NDArray[np.float64] = 0.0
+    misalignment: NDArray[np.float64] = field(default_factory=lambda: np.zeros((3, 3)))
     quantization: float = 0.0
     saturation: float = np.inf
 
@@ -140,7 +149,8 @@ class GyroErrors:
             x = phi * x + w[k]
         return b
 
-    def apply(self, data: np.ndarray, kind: str, h: float, rng) -> np.ndarray:
+    def apply(self, data: NDArray[np.float64], kind: InputKind, h: float, rng: RngLike
+              ) -> NDArray[np.float64]:
         """Corrupt true increments or rates ``data`` (n, 3) sampled at interval ``h``."""
         rng = np.random.default_rng(rng)
         n = data.shape[0]
@@ -172,7 +182,7 @@ def _edges(h, n, t0):
 
 
 def increments(motion: Motion, h: float, n: int, *, t0: float = 0.0,
-               errors: GyroErrors | None = None, rng=None) -> GyroRecord:
+               errors: GyroErrors | None = None, rng: RngLike = None) -> GyroRecord:
     """``n`` angular increments over ``[t0 + k h, t0 + (k+1) h]`` (exact, then corrupted)."""
     h, n, edges = _edges(h, n, t0)
     theta = motion.increments(edges)
@@ -182,7 +192,7 @@ def increments(motion: Motion, h: float, n: int, *, t0: float = 0.0,
 
 
 def rate_samples(motion: Motion, h: float, n: int, *, t0: float = 0.0,
-                 errors: GyroErrors | None = None, rng=None) -> GyroRecord:
+                 errors: GyroErrors | None = None, rng: RngLike = None) -> GyroRecord:
     """``n`` rate samples at ``t0 + k h`` (k = 0 … n−1)."""
     h, n, edges = _edges(h, n, t0)
     t = edges[:-1]
@@ -193,7 +203,8 @@ def rate_samples(motion: Motion, h: float, n: int, *, t0: float = 0.0,
 
 
 def preaveraged_increments(motion: Motion, h: float, n: int, m: int, *, t0: float = 0.0,
-                           errors: GyroErrors | None = None, rng=None) -> GyroRecord:
+                           errors: GyroErrors | None = None, rng: RngLike = None
+                           ) -> GyroRecord:
     """Increments from ``m`` raw rate samples per interval, pre-averaged (Li & Zhang 2017 eq. 11).
 
     Raw rates are taken at the midpoints of the ``m`` sub-intervals of each
@@ -224,8 +235,8 @@ class AccelerometerErrors:
     """
 
     white_noise: float = 0.0
-    bias: float | np.ndarray = 0.0
-    scale_factor: float | np.ndarray = 0.0
+    bias: float | NDArray[np.float64] = 0.0
+    scale_factor: float | NDArray[np.float64] = 0.0
     vibration_amplitude: float = 0.0
     vibration_hz: float = 30.0
     vibration_noise: float = 0.0
@@ -242,7 +253,8 @@ class AccelerometerErrors:
         if not self.vibration_stop >= self.vibration_start:
             raise ValueError("vibration_stop must not precede vibration_start")
 
-    def apply(self, t, f, h: float, rng) -> np.ndarray:
+    def apply(self, t: ArrayLike, f: NDArray[np.float64], h: float, rng: RngLike
+              ) -> NDArray[np.float64]:
         """Corrupt the true specific force ``f`` (n, 3) sampled at ``t`` every ``h`` s."""
         rng = np.random.default_rng(rng)
         t = np.asarray(t, float)
@@ -270,9 +282,9 @@ class MagnetometerErrors:
     """
 
     white_noise: float = 0.0
-    hard_iron: float | np.ndarray = 0.0
-    soft_iron: np.ndarray = field(default_factory=lambda: np.zeros((3, 3)))
-    anomaly: float | np.ndarray = 0.0
+    hard_iron: float | NDArray[np.float64] = 0.0
+    soft_iron: NDArray[np.float64] = field(default_factory=lambda: np.zeros((3, 3)))
+    anomaly: float | NDArray[np.float64] = 0.0
     anomaly_start: float = 0.0
     anomaly_stop: float = 0.0
 
@@ -285,7 +297,8 @@ class MagnetometerErrors:
         _vec3(self.hard_iron, "hard_iron")
         _vec3(self.anomaly, "anomaly")
 
-    def apply(self, t, m_b, c_b_n, rng) -> np.ndarray:
+    def apply(self, t: ArrayLike, m_b: NDArray[np.float64], c_b_n: NDArray[np.float64],
+              rng: RngLike) -> NDArray[np.float64]:
         """Corrupt the true body-frame field ``m_b`` (n, 3); ``c_b_n`` (n, 3, 3) rotates the
         anomaly into the body."""
         rng = np.random.default_rng(rng)
@@ -299,8 +312,9 @@ class MagnetometerErrors:
         return x
 
 
-def accelerometer(t, q_n_b, specific_force, h: float, *, errors: AccelerometerErrors | None = None,
-                  rng=None) -> np.ndarray:
+def accelerometer(t: ArrayLike, q_n_b: ArrayLike, specific_force: ArrayLike, h: float, *,
+                  errors: AccelerometerErrors | None = None, rng: RngLike = None
+                  ) -> NDArray[np.float64]:
     """Accelerometer samples (m/s²) of the true body specific force, corrupted if asked.
 
     ``q_n_b`` is accepted for symmetry with :func:`magnetometer` and unused.
@@ -311,8 +325,9 @@ def accelerometer(t, q_n_b, specific_force, h: float, *, errors: AccelerometerEr
     return errors.apply(t, f, positive(h, "h"), rng)
 
 
-def magnetometer(t, q_n_b, field_n, *, errors: MagnetometerErrors | None = None,
-                 rng=None) -> np.ndarray:
+def magnetometer(t: ArrayLike, q_n_b: ArrayLike, field_n: ArrayLike, *,
+                 errors: MagnetometerErrors | None = None, rng: RngLike = None
+                 ) -> NDArray[np.float64]:
     """Magnetometer samples: the reference-frame field ``field_n`` (3,) seen in the body."""
     from strapdown.rotation.dcm import dcm_from_quat
 

@@ -25,9 +25,12 @@ circle, 250 s in all) in one of its three consistent readings — the paper's
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass
+from typing import Literal, get_args
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from strapdown._core.validation import positive
 
@@ -37,11 +40,15 @@ __all__ = [
     "EarthField",
     "Segment",
     "VehicleState",
+    "WangVariant",
     "wang_circle",
 ]
 
 G = 9.80665
-WANG_VARIANTS = ("speed-radius", "speed-bank", "radius-bank")
+#: The consistent readings of Wang, Wang & Wang's loiter (see the module docstring).
+WangVariant = Literal["speed-radius", "speed-bank", "radius-bank"]
+#: Their names, in the order the module docstring lists them.
+WANG_VARIANTS: tuple[WangVariant, ...] = get_args(WangVariant)
 
 
 @dataclass(frozen=True)
@@ -65,7 +72,7 @@ class EarthField:
     declination_deg: float = 0.0
     gravity: float = G
 
-    def magnetic_enu(self) -> np.ndarray:
+    def magnetic_enu(self) -> NDArray[np.float64]:
         """The field vector in ENU, µT."""
         i = math.radians(self.inclination_deg)
         d = math.radians(self.declination_deg)
@@ -85,15 +92,15 @@ class Segment:
 class VehicleState:
     """Sampled trajectory (SI units, ENU reference, FLU body)."""
 
-    t: np.ndarray
-    position: np.ndarray
-    velocity: np.ndarray
-    acceleration: np.ndarray
-    q: np.ndarray
-    omega: np.ndarray
-    specific_force: np.ndarray
-    heading: np.ndarray
-    bank: np.ndarray
+    t: NDArray[np.float64]
+    position: NDArray[np.float64]
+    velocity: NDArray[np.float64]
+    acceleration: NDArray[np.float64]
+    q: NDArray[np.float64]
+    omega: NDArray[np.float64]
+    specific_force: NDArray[np.float64]
+    heading: NDArray[np.float64]
+    bank: NDArray[np.float64]
 
 
 class CoordinatedFlight:
@@ -114,8 +121,8 @@ class CoordinatedFlight:
     gravity : float
     """
 
-    def __init__(self, segments, *, speed: float, altitude: float = 0.0,
-                 heading0_deg: float = 0.0, roll_time: float = 2.0, gravity: float = G):
+    def __init__(self, segments: Iterable[Segment], *, speed: float, altitude: float = 0.0,
+                 heading0_deg: float = 0.0, roll_time: float = 2.0, gravity: float = G) -> None:
         self.segments = tuple(segments)
         if not self.segments:
             raise ValueError("give at least one segment")
@@ -187,7 +194,7 @@ class CoordinatedFlight:
             self._sol = sols
         return self._sol
 
-    def sample(self, t) -> VehicleState:
+    def sample(self, t: ArrayLike) -> VehicleState:
         """The trajectory at times ``t`` (s, within ``[0, duration]``)."""
         t = np.asarray(t, float)
         if t.ndim != 1 or t.size == 0:
@@ -221,8 +228,9 @@ class CoordinatedFlight:
         return VehicleState(t, pos, vel, acc, q, omega, f, psi, phi)
 
 
-def wang_circle(variant: str = "speed-radius", *, roll_time: float = 2.0) -> CoordinatedFlight:
-    """Seed 001's loiter scenario in a consistent reading (see the module docstring)."""
+def wang_circle(variant: WangVariant = "speed-radius", *,
+                roll_time: float = 2.0) -> CoordinatedFlight:
+    """Wang, Wang & Wang's loiter scenario in a consistent reading (see the module docstring)."""
     if variant not in WANG_VARIANTS:
         raise ValueError(f"variant must be one of {', '.join(WANG_VARIANTS)}, got {variant!r}")
     speed, radius, bank = 20.0, 600.0, math.radians(20.0)
