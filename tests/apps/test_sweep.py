@@ -13,6 +13,7 @@ from pathlib import Path
 
 import pytest
 
+from strapdown._core.compile_notice import MESSAGE
 from strapdown.apps.sweep import cases, load_scenario, sweep
 
 SCENARIO = textwrap.dedent("""
@@ -142,3 +143,51 @@ def test_cli_sweep_and_bad_scheduler(tmp_path, capsys):
         main(["sweep", str(scn), "--out", str(tmp_path / "o"), "--scheduler", "dask:/x"])
     assert exc.value.code == 2
     assert "local' or 'dask://HOST:PORT'" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("workers", ["1", "2"])
+def test_ctrl_c_stops_sweep_with_one_line_and_status_130(tmp_path, workers):
+    """SIGINT to the process group (what Ctrl-C sends): one line, no traceback, exit 130,
+    the pool's workers gone, and the line's count is the number of saved cases."""
+    scn = _scenario(tmp_path, duration=20.0)
+    out = tmp_path / "interrupted"
+    cmd = [sys.executable, "-m", "strapdown.cli", "sweep", str(scn), "--out", str(out),
+           "--workers", workers, "--no-progress"]
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            start_new_session=True)
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and proc.poll() is None:
+        if len(list((out / "cases").glob("[!.]*.json"))) >= 2:
+            break
+        time.sleep(0.01)
+    os.killpg(proc.pid, signal.SIGINT)
+    stdout, stderr = proc.communicate(timeout=60)
+    assert proc.returncode == 130, stderr
+    assert "Traceback" not in stderr and stdout == ""
+    lines = [ln for ln in stderr.strip().splitlines() if ln != MESSAGE]  # cold cache: + notice
+    assert lines[0] == "24 cases: 0 already done, 24 to run (local pool)"
+    done = len(list((out / "cases").glob("[!.]*.json")))
+    assert lines[-1] == (f"strapdown sweep: interrupted, {done}/24 cases done; "
+                         "rerun the same command to resume")
+    assert 2 <= done < 24
+    time.sleep(0.5)
+    with pytest.raises(ProcessLookupError):  # no worker left running in the group
+        os.killpg(proc.pid, 0)
+
+
+def test_cli_sweep_status_lines_printed_once(tmp_path, capsys):
+    from strapdown.cli import main
+
+    scn = _scenario(tmp_path, duration=1.0)
+    assert main(["sweep", str(scn), "--out", str(tmp_path / "o"), "--workers", "1",
+                 "--max-cases", "3", "--format", "csv"]) == 3
+    got = capsys.readouterr()
+    assert got.out == "3 of 24 cases done; rerun to finish\n"
+    quiet = got.err.replace(MESSAGE + "\n", "")  # a cold cache adds the compile notice
+    assert quiet == "24 cases: 0 already done, 3 to run (local pool)\n"
+    assert main(["sweep", str(scn), "--out", str(tmp_path / "o"), "--workers", "2",
+                 "--format", "csv"]) == 0
+    got = capsys.readouterr()
+    assert got.out == f"wrote {tmp_path / 'o' / 'results.csv'} (24 cases, 3 reused)\n"
+    quiet = got.err.replace(MESSAGE + "\n", "")
+    assert quiet == "24 cases: 3 already done, 21 to run (local pool)\n"

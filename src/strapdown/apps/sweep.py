@@ -60,7 +60,8 @@ from strapdown.analysis.evaluate import EvaluationConfig, evaluate
 from strapdown.io.files import atomic_path, csv_table, write_text
 from strapdown.truth.sensors import GyroErrors
 
-__all__ = ["Case", "Scenario", "SweepResult", "cases", "load_scenario", "run_case", "sweep"]
+__all__ = ["Case", "Scenario", "SweepInterrupted", "SweepResult", "cases", "load_scenario",
+           "run_case", "sweep"]
 
 #: Metric names a scenario may ask for (keys of Evaluation.to_dict).
 METRICS = ("max_error_rad", "rms_error_rad", "cone_axis_drift_rad_s", "predicted_drift_rad_s",
@@ -179,7 +180,7 @@ def load_scenario(path) -> Scenario:
 def cases(scn: Scenario) -> list[Case]:
     """Every case of a scenario, in table order (grid point major, algorithm minor)."""
     keys = list(scn.grid)
-    out = []
+    out: list[Case] = []
     points = list(itertools.product(*(scn.grid[k] for k in keys))) if keys else [()]
     for p, values in enumerate(points):
         params = dict(zip(keys, values, strict=True))
@@ -246,6 +247,20 @@ class SweepResult:
         return self.csv is not None
 
 
+class SweepInterrupted(KeyboardInterrupt):
+    """Ctrl-C stopped a sweep; its finished cases are saved and a rerun resumes.
+
+    ``str()`` is the one line the command line prints, e.g. ``interrupted, 9/30 cases done;
+    rerun the same command to resume``.
+    """
+
+    def __init__(self, done: int, total: int) -> None:
+        super().__init__(f"interrupted, {done}/{total} cases done; rerun the same command "
+                         "to resume")
+        self.done = done
+        self.total = total
+
+
 def _parse_scheduler(scheduler: str):
     if scheduler == "local":
         return "local", None
@@ -276,6 +291,15 @@ def sweep(scenario, out, *, scheduler: str = "local", workers: int | None = None
         only when the grid is complete).
     progress : bool
         Progress bar (tqdm) on stderr.
+    log : callable, optional
+        Receives one status line before the run (cases done, to run, where); the outcome
+        is the returned :class:`SweepResult`.
+
+    Raises
+    ------
+    SweepInterrupted
+        On Ctrl-C (a ``KeyboardInterrupt``), after stopping the workers; it says how many
+        cases are saved.
     """
     kind, address = _parse_scheduler(scheduler)
     formats = tuple(formats)
@@ -315,20 +339,23 @@ def sweep(scenario, out, *, scheduler: str = "local", workers: int | None = None
 
     from tqdm import tqdm
 
-    with tqdm(total=len(pending), disable=not progress, unit="case", file=sys.stderr) as bar:
-        if kind == "dask":
-            _run_dask(address, pending, finish, bar)
-        else:
-            _run_local(pending, workers, finish, bar)
+    try:
+        with tqdm(total=len(pending), disable=not progress, unit="case",
+                  file=sys.stderr) as bar:
+            if kind == "dask":
+                _run_dask(address, pending, finish, bar)
+            else:
+                _run_local(pending, workers, finish, bar)
+    except KeyboardInterrupt:
+        done = sum((store / f"{c.key}.json").is_file() for c in all_cases)
+        raise SweepInterrupted(done, len(all_cases)) from None
     done = sum((store / f"{c.key}.json").is_file() for c in all_cases)
     if done < len(all_cases):
-        say(f"{done} of {len(all_cases)} cases done; rerun to finish")
         return SweepResult(len(all_cases), skipped, len(pending), None, None)
     rows = [json.loads((store / f"{c.key}.json").read_text(encoding="utf-8"))["row"]
             for c in all_cases]
     csv_path = _write_csv(out / "results.csv", rows)
     pq = _write_parquet(out / "results.parquet", rows) if "parquet" in formats else None
-    say(f"wrote {csv_path}" + (f" and {pq}" if pq else ""))
     return SweepResult(len(all_cases), skipped, len(pending), csv_path, pq)
 
 
@@ -340,18 +367,27 @@ def _run_local(pending, workers, finish, bar) -> None:
             finish(c, run_case(c))
             bar.update()
         return
-    from concurrent.futures import ProcessPoolExecutor, as_completed
+    import multiprocessing
 
-    pool = ProcessPoolExecutor(max_workers=workers)
-    try:
-        futures = {pool.submit(run_case, c): c for c in pending}
-        for fut in as_completed(futures):
-            finish(futures[fut], fut.result())
+    from strapdown._core import compile_notice
+
+    # Workers ignore Ctrl-C (the parent alone reports it) and carry the compile notice; on
+    # any exception, Ctrl-C included, leaving the block terminates them at once.
+    ctx = multiprocessing.get_context()
+    said = ctx.Value("b", 0)
+    with ctx.Pool(workers, initializer=compile_notice.worker_initializer,
+                  initargs=(said, compile_notice.active())) as pool:
+        for i, row in pool.imap_unordered(_run_numbered, enumerate(pending)):
+            finish(pending[i], row)
             bar.update()
-    except BaseException:
-        pool.shutdown(wait=False, cancel_futures=True)
-        raise
-    pool.shutdown()
+        pool.close()
+        pool.join()
+
+
+def _run_numbered(item: tuple[int, Case]) -> tuple[int, dict]:
+    """``(i, case)`` → ``(i, row)``: a pool result that names its case."""
+    i, case = item
+    return i, run_case(case)
 
 
 def _run_dask(address, pending, finish, bar) -> None:

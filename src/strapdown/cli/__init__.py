@@ -9,13 +9,17 @@ only when their subcommand is parsed, so ``strapdown --version`` and ``--help`` 
 numerical library of their own.
 
 Every subcommand validates its flags and exits with status 2 and one line on stderr naming
-the problem on bad input (no traceback).
+the problem on bad input (no traceback). Ctrl-C, and a file that cannot be read or written,
+likewise end in one line and their own status (:data:`EXIT_STATUS`, documented in the README
+and in ``strapdown --help``). A command that is about to compile the numba kernels on a cold
+cache says so on stderr first (:mod:`strapdown._core.compile_notice`).
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
+import textwrap
 
 from strapdown.cli import (
     ahrs,
@@ -29,13 +33,40 @@ from strapdown.cli import (
     run,
     sweep,
 )
-from strapdown.cli._common import CommandParser, Parser
+from strapdown.cli._common import CommandParser, HelpFormatter, Parser, say
 
-__all__ = ["COMMANDS", "build_parser", "main"]
+__all__ = ["COMMANDS", "EXIT_STATUS", "build_parser", "main"]
 
 #: The subcommand modules, in the order ``strapdown --help`` lists them.
 COMMANDS = (evaluate, coefficients, export_c, run, compare, sweep, ahrs, benchmark_ahrs,
             reproduce, bench)
+
+EXIT_OK, EXIT_USAGE, EXIT_IO, EXIT_INTERRUPTED, EXIT_PIPE = 0, 2, 74, sweep.INTERRUPTED, 141
+
+#: Every exit status of every command and what it means (README, ``strapdown --help``).
+EXIT_STATUS = {
+    EXIT_OK: "success",
+    1: "an unexpected error (a bug: the traceback is printed; please report it)",
+    EXIT_USAGE: "bad input: an option, a value or an input file is wrong (one line on stderr "
+    "names it; nothing is written)",
+    sweep.INCOMPLETE: "sweep only: stopped by --max-cases before the grid was complete "
+    "(rerun to finish)",
+    EXIT_IO: "a file or directory could not be read or written (one line names the path)",
+    EXIT_INTERRUPTED: "interrupted (Ctrl-C); a sweep keeps its finished cases, rerun the same "
+    "command to resume",
+    EXIT_PIPE: "stdout closed early (e.g. piped into head); nothing more is printed",
+}
+
+#: Commands that never run a numba kernel: no compile notice (numba is not even imported).
+_NO_KERNELS = frozenset({"coefficients"})
+
+
+class _LinesFormatter(HelpFormatter):
+    """Wraps each line of the description and epilog on its own (one exit status a line)."""
+
+    def _fill_text(self, text: str, width: int, indent: str) -> str:
+        return "\n".join(textwrap.fill(line, width, initial_indent=indent, subsequent_indent=(
+            indent + " " * 7 if line.startswith("  ") else indent)) for line in text.splitlines())
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -43,7 +74,10 @@ def build_parser() -> argparse.ArgumentParser:
     from strapdown import __version__
 
     p = Parser(prog="strapdown", description="Strapdown attitude algorithms for high-dynamic "
-               "bodies: evaluate algorithms against exact motions, reproduce papers.")
+               "bodies: evaluate algorithms against exact motions, reproduce papers.",
+               formatter_class=_LinesFormatter,
+               epilog="exit status:\n" + "\n".join(f"  {code:<5d}{text}"
+                                                    for code, text in EXIT_STATUS.items()))
     p.add_argument("--version", action="version", version=f"strapdown {__version__}")
     sub = p.add_subparsers(dest="command", required=True, parser_class=CommandParser)
     for command in COMMANDS:
@@ -54,15 +88,50 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     """Run the command line on ``argv`` (default ``sys.argv[1:]``); returns the exit status.
 
-    Bad input exits with status 2 and ``strapdown COMMAND: error: …`` on stderr.
+    Bad input exits with status 2 and ``strapdown COMMAND: error: …`` on stderr; Ctrl-C with
+    130 and ``strapdown COMMAND: interrupted``; an unreadable or unwritable file with 74 and
+    the path (see :data:`EXIT_STATUS`). These exits raise ``SystemExit`` as argparse does.
     """
     parser = build_parser()
-    args = parser.parse_args(sys.argv[1:] if argv is None else argv)
+    prog = "strapdown"
     try:
-        return args.handler(args)
+        args = parser.parse_args(sys.argv[1:] if argv is None else argv)
+        prog = f"strapdown {args.command}"
+        if args.command in _NO_KERNELS:
+            return args.handler(args)
+        from strapdown._core.compile_notice import notice
+
+        with notice(say):
+            return args.handler(args)
     except ValueError as exc:
-        parser.exit(2, f"strapdown {args.command}: error: {exc}\n")
+        parser.exit(EXIT_USAGE, f"{prog}: error: {exc}\n")
+    except KeyboardInterrupt as exc:  # a sweep's says how far it got
+        parser.exit(EXIT_INTERRUPTED, f"{prog}: {str(exc) or 'interrupted'}\n")
+    except BrokenPipeError:
+        _silence_stdout()
+        parser.exit(EXIT_PIPE)
+    except OSError as exc:
+        parser.exit(EXIT_IO, f"{prog}: error: {_os_error(exc)}\n")
     return 1  # pragma: no cover
+
+
+def _os_error(exc: OSError) -> str:
+    """``path: reason`` (both paths of a rename or copy), or the error's own text."""
+    paths = [str(p) for p in (exc.filename, exc.filename2) if p is not None]
+    if not paths:
+        return str(exc)
+    return f"{' -> '.join(paths)}: {exc.strerror or type(exc).__name__}"
+
+
+def _silence_stdout() -> None:
+    """Point stdout at /dev/null so the interpreter's final flush into a closed pipe is quiet."""
+    import os
+
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError):  # no real stdout (captured): nothing to silence
+        pass
 
 
 if __name__ == "__main__":  # pragma: no cover

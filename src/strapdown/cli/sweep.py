@@ -10,6 +10,9 @@ __all__ = ["INCOMPLETE", "add_parser", "run"]
 
 #: Exit status of a sweep stopped (``--max-cases``) before its grid is complete.
 INCOMPLETE = 3
+#: Exit status of any command stopped by Ctrl-C (128 + SIGINT; :func:`strapdown.cli.main`
+#: prints the :class:`~strapdown.apps.sweep.SweepInterrupted` line).
+INTERRUPTED = 130
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
@@ -19,8 +22,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         help="run a TOML scenario's parameter grid (resumable)",
         description="Run every case of a scenario file's grid; each finished case is saved at "
         "once, so an interrupted sweep resumes where it stopped. Writes OUT/results.csv and "
-        "OUT/results.parquet when the grid is complete. Exits with status "
-        f"{INCOMPLETE} when --max-cases stops it first.")
+        "OUT/results.parquet when the grid is complete. Exit status: 0 complete, "
+        f"{INCOMPLETE} when --max-cases stops it first, {INTERRUPTED} on Ctrl-C (one line "
+        "says how many cases are saved; rerun the same command to resume), 2 bad input.")
     p.set_defaults(handler=run)
     return p
 
@@ -40,7 +44,11 @@ def _arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run (or finish) the grid; exit status :data:`INCOMPLETE` if cases remain."""
+    """Run (or finish) the grid; exit status :data:`INCOMPLETE` if cases remain.
+
+    Ctrl-C raises :class:`~strapdown.apps.sweep.SweepInterrupted` (a ``KeyboardInterrupt``),
+    which :func:`strapdown.cli.main` turns into its line and :data:`INTERRUPTED`.
+    """
     from strapdown.apps.sweep import sweep
 
     res = sweep(args.scenario, args.out, scheduler=args.scheduler, workers=args.workers,

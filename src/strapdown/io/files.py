@@ -27,19 +27,25 @@ def atomic_path(path: str | os.PathLike):
     """Yield a temporary path in the target's directory; rename it over ``path`` on success.
 
     The file gets the mode a plain ``open(path, "w")`` would give it (0666 less the
-    umask), not the 0600 of the private temporary file.
+    umask), not the 0600 of the private temporary file. An ``OSError`` about the temporary
+    file is raised as one about ``path`` (the name the user gave).
     """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=path.suffix, dir=path.parent)
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=path.suffix, dir=path.parent)
+    except OSError as exc:
+        raise OSError(exc.errno, exc.strerror, str(path)) from None
     os.close(fd)
     try:
         yield Path(tmp)
         os.chmod(tmp, 0o666 & ~_umask())
         os.replace(tmp, path)
-    except BaseException:
+    except BaseException as exc:
         with contextlib.suppress(FileNotFoundError):
             os.unlink(tmp)
+        if isinstance(exc, OSError) and exc.filename in (tmp, Path(tmp)):
+            raise OSError(exc.errno, exc.strerror, str(path)) from None
         raise
 
 

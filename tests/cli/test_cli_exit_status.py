@@ -1,0 +1,86 @@
+"""Exit statuses: Ctrl-C, unwritable files and a closed stdout end in one line (or none) and
+their documented status, never a traceback; ``strapdown --help`` lists every status."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import pytest
+
+from strapdown.cli import EXIT_STATUS, main
+
+
+def _exit(capsys, *args) -> tuple[int, str]:
+    with pytest.raises(SystemExit) as exc:
+        main(list(args))
+    return exc.value.code, capsys.readouterr().err
+
+
+def _evaluate_raises(monkeypatch, error: BaseException) -> None:
+    from strapdown.analysis import evaluate
+
+    def boom(cfg):
+        raise error
+
+    monkeypatch.setattr(evaluate, "evaluate", boom)
+
+
+def test_ctrl_c_is_one_line_and_status_130(monkeypatch, capsys):
+    _evaluate_raises(monkeypatch, KeyboardInterrupt())
+    assert _exit(capsys, "evaluate", "--duration", "0.1") == (
+        130, "strapdown evaluate: interrupted\n")
+
+
+def test_sweep_interruption_says_how_far_it_got(monkeypatch, capsys):
+    from strapdown.apps import sweep
+
+    def interrupted(*args, **kwargs):
+        raise sweep.SweepInterrupted(9, 30)
+
+    monkeypatch.setattr(sweep, "sweep", interrupted)
+    assert _exit(capsys, "sweep", "scenario.toml", "--out", "o") == (
+        130, "strapdown sweep: interrupted, 9/30 cases done; rerun the same command to resume\n")
+
+
+@pytest.mark.parametrize(("error", "line"), [
+    (PermissionError(13, "Permission denied", "out/att.csv"), "out/att.csv: Permission denied"),
+    (OSError(28, "No space left on device", "a.tmp", None, "a.csv"),
+     "a.tmp -> a.csv: No space left on device"),
+    (OSError("no path given"), "no path given"),
+])
+def test_os_error_names_the_path_with_status_74(monkeypatch, capsys, error, line):
+    _evaluate_raises(monkeypatch, error)
+    assert _exit(capsys, "evaluate", "--duration", "0.1") == (
+        74, f"strapdown evaluate: error: {line}\n")
+
+
+def test_unwritable_output_names_the_target_not_a_temp_file(tmp_path, capsys):
+    blocker = tmp_path / "file"
+    blocker.write_text("")  # a file where the output directory should be
+    code, err = _exit(capsys, "export-c", "--algorithm", "rotvec", "--structure",
+                      "single-chain", "--subsamples", "3", "--out", str(blocker / "flight"))
+    assert code == 74 and err.startswith("strapdown export-c: error: ")
+    assert str(blocker) in err and "/." not in err and "Traceback" not in err
+
+
+def test_closed_stdout_is_quiet_with_status_141():
+    proc = subprocess.Popen([sys.executable, "-m", "strapdown.cli", "coefficients", "--form",
+                             "cross-with-last", "--subsamples", "2"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    proc.stdout.close()  # the reader is gone before the command prints
+    err = proc.stderr.read()
+    assert proc.wait(timeout=120) == 141 and err == ""
+
+
+def test_help_lists_every_exit_status(capsys):
+    assert _exit(capsys, "--help")[0] == 0
+    # (help goes to stdout; _exit read stderr, so read the help again)
+    with pytest.raises(SystemExit):
+        main(["--help"])
+    text = capsys.readouterr().out
+    epilog = text[text.index("exit status:"):].splitlines()[1:]
+    listed = [int(line.split()[0]) for line in epilog if line.startswith("  ") and
+              line.split()[0].isdigit()]
+    assert listed == list(EXIT_STATUS) == sorted(EXIT_STATUS)
+    assert {0, 2, 3, 74, 130} <= set(EXIT_STATUS)
