@@ -10,10 +10,12 @@ The error metrics are in :mod:`strapdown.analysis.broad`.
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import NDArray
 
 __all__ = ["BroadTrial", "read_broad"]
 
@@ -23,19 +25,19 @@ class BroadTrial:
     """One BROAD recording (SI units; ``mag`` in µT)."""
 
     name: str
-    t: np.ndarray
-    gyro: np.ndarray
-    acc: np.ndarray
-    mag: np.ndarray
-    q_ref: np.ndarray
-    movement: np.ndarray
+    t: NDArray[np.float64]
+    gyro: NDArray[np.float64]
+    acc: NDArray[np.float64]
+    mag: NDArray[np.float64]
+    q_ref: NDArray[np.float64]
+    movement: NDArray[np.bool_]
 
     @property
     def h(self) -> float:
         return float(self.t[1] - self.t[0])
 
 
-def read_broad(path) -> BroadTrial:
+def read_broad(path: str | os.PathLike[str]) -> BroadTrial:
     """Load a BROAD ``.mat`` trial; errors name what is missing."""
     from scipy.io import loadmat
 

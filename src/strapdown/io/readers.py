@@ -25,19 +25,31 @@ from __future__ import annotations
 import csv
 import io as _io
 import itertools
+import os
 import re
 import warnings
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any, Literal, get_args
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
+from strapdown._core.kinds import INPUT_KINDS, InputKind
 from strapdown._core.validation import first_bad_step
 from strapdown.io.files import atomic_path
 
 __all__ = [
+    "GAP_POLICIES",
+    "INCREMENT_UNITS",
     "RATE_PLAUSIBLE_MAX",
+    "RATE_UNITS",
+    "GapPolicy",
+    "GyroUnit",
     "ImuLog",
+    "IncrementUnit",
+    "RateUnit",
     "UnitWarning",
     "check_rows",
     "csv_columns",
@@ -50,6 +62,19 @@ __all__ = [
 #: spinning shells reach 20 r/s ≈ 126 rad/s, so only beyond 200 rad/s do we suspect deg/s).
 RATE_PLAUSIBLE_MAX = 200.0
 _DEG = np.pi / 180.0
+
+#: Units of a rate log.
+RateUnit = Literal["rad/s", "deg/s"]
+#: Units of an increment log.
+IncrementUnit = Literal["rad", "deg"]
+#: Any gyro-log unit (a rate log takes a :data:`RateUnit`, an increment log an
+#: :data:`IncrementUnit`).
+GyroUnit = Literal[RateUnit, IncrementUnit]
+#: What :func:`read_imu` does at a gap: list it in :attr:`ImuLog.gaps`, or raise.
+GapPolicy = Literal["report", "error"]
+RATE_UNITS: tuple[RateUnit, ...] = get_args(RateUnit)
+INCREMENT_UNITS: tuple[IncrementUnit, ...] = get_args(IncrementUnit)
+GAP_POLICIES: tuple[GapPolicy, ...] = get_args(GapPolicy)
 
 
 class UnitWarning(UserWarning):
@@ -75,12 +100,12 @@ class ImuLog:
         Rows (1-based) with a component at or above the declared saturation.
     """
 
-    t: np.ndarray
-    data: np.ndarray
-    kind: str
+    t: NDArray[np.float64]
+    data: NDArray[np.float64]
+    kind: InputKind
     h: float
-    gaps: list = field(default_factory=list)
-    saturated: list = field(default_factory=list)
+    gaps: list[int] = field(default_factory=list)
+    saturated: list[int] = field(default_factory=list)
 
     def segments(self) -> list[slice]:
         """Index ranges between gaps: each a gap-free run of samples.
@@ -107,7 +132,8 @@ def _split_header(cells):
     return names, units
 
 
-def csv_columns(path, columns, optional=()) -> tuple[np.ndarray, dict, bool]:
+def csv_columns(path: str | os.PathLike[str], columns: Sequence[str],
+                optional: Sequence[str] = ()) -> tuple[NDArray[np.float64], dict[str, str], bool]:
     """Named columns of a CSV log with a header row.
 
     Returns ``(values, units, have_optional)``: ``values`` holds ``columns``
@@ -150,7 +176,8 @@ def _load_csv(path: Path, columns):
     return raw, (axis_units.pop() if axis_units else None)
 
 
-def check_rows(path, t, groups) -> None:
+def check_rows(path: str | os.PathLike[str], t: NDArray[np.float64],
+               groups: Iterable[tuple[str | None, Iterable[ArrayLike]]]) -> None:
     """Raise on the first non-finite row of each group and on a bad time step.
 
     ``groups``: ``(label, arrays)`` pairs checked in order; a row is bad when
@@ -173,7 +200,8 @@ def check_rows(path, t, groups) -> None:
                          f"after {t[i]!r})")
 
 
-def warn_implausible_rate(path, rate, declared: str, suggestion: str = "degrees") -> None:
+def warn_implausible_rate(path: str | os.PathLike[str], rate: NDArray[np.float64], declared: str,
+                          suggestion: str = "degrees") -> None:
     """Warn when rates (rad/s) declared in radians have magnitudes that suggest degrees."""
     big = float(np.percentile(np.linalg.norm(rate, axis=1), 99))
     if not declared.startswith("deg") and big > RATE_PLAUSIBLE_MAX:
@@ -245,9 +273,10 @@ def _load(path: Path, columns, sample_rate_hz):
                      ".mat)")
 
 
-def read_imu(path, *, kind: str, units: str | None, columns=("t", "gx", "gy", "gz"),
+def read_imu(path: str | os.PathLike[str], *, kind: InputKind, units: GyroUnit | None,
+             columns: Sequence[str] = ("t", "gx", "gy", "gz"),
              sample_rate_hz: float | None = None, gap_tolerance: float = 1.5,
-             on_gap: str = "report", saturation: float | None = None) -> ImuLog:
+             on_gap: GapPolicy = "report", saturation: float | None = None) -> ImuLog:
     """Read and validate a gyro log (see the module docstring).
 
     Parameters
@@ -269,12 +298,12 @@ def read_imu(path, *, kind: str, units: str | None, columns=("t", "gx", "gy", "g
         or above it are listed in :attr:`ImuLog.saturated`.
     """
     path = Path(path)
-    if kind not in ("rate", "increment"):
+    if kind not in INPUT_KINDS:
         raise ValueError(f"kind must be 'rate' or 'increment', got {kind!r}")
-    allowed = ("rad/s", "deg/s") if kind == "rate" else ("rad", "deg")
+    allowed: tuple[GyroUnit, ...] = RATE_UNITS if kind == "rate" else INCREMENT_UNITS
     if units is not None and units not in allowed:
         raise ValueError(f"{kind} units must be one of {allowed}, got {units!r}")
-    if on_gap not in ("report", "error"):
+    if on_gap not in GAP_POLICIES:
         raise ValueError(f"on_gap must be 'report' or 'error', got {on_gap!r}")
     if not gap_tolerance > 1:
         raise ValueError(f"gap_tolerance is in sample intervals and must exceed 1, got "
@@ -325,10 +354,13 @@ def read_imu(path, *, kind: str, units: str | None, columns=("t", "gx", "gy", "g
     return ImuLog(np.asarray(t, float), np.ascontiguousarray(g), kind, h, gaps, saturated)
 
 
-def write_attitude(path, t, q, *, extra: dict | None = None) -> Path:
+def write_attitude(path: str | os.PathLike[str], t: ArrayLike, q: NDArray[np.float64], *,
+                   extra: dict[str, ArrayLike] | None = None) -> Path:
     """Write ``t, qw, qx, qy, qz`` (+ extra columns) atomically as CSV or ``.npz``."""
     path = Path(path)
-    cols = {"t": np.asarray(t), "qw": q[:, 0], "qx": q[:, 1], "qy": q[:, 2], "qz": q[:, 3]}
+    # Any: np.savez's column keywords share its signature with allow_pickle: bool
+    cols: dict[str, Any] = {"t": np.asarray(t), "qw": q[:, 0], "qx": q[:, 1], "qy": q[:, 2],
+                            "qz": q[:, 3]}
     cols.update(extra or {})
     if path.suffix.lower() == ".npz":
         with atomic_path(path) as tmp, open(tmp, "wb") as f:
