@@ -26,7 +26,7 @@ from strapdown.algorithms.coning import (
     table1_drift_constant,
 )
 from strapdown.algorithms.family import DriftLaw, Family, IncrementStructure
-from strapdown.algorithms.structures import AttitudeSolution, run_structure
+from strapdown.algorithms.structures import AttitudeSolution, increment_structure, run_structure
 
 if TYPE_CHECKING:
     from numpy.typing import ArrayLike
@@ -76,15 +76,16 @@ class Rotvec(Family):
 
     def run(self, spec: AlgorithmSpec, data: ArrayLike, *, h: float, t: ArrayLike | None = None,
             t0: float = 0.0, q0: ArrayLike | None = None) -> AttitudeSolution:
-        return run_structure(_structure(spec), data, self.coefficient_set(spec), h=h, t0=t0,
-                             q0=q0)
+        return run_structure(increment_structure(spec.structure), data,
+                             self.coefficient_set(spec), h=h, t0=t0, q0=q0)
 
     def run_mp(self, spec: AlgorithmSpec, motion: Motion, *, h: float, samples: int,
                digits: int) -> MpSolution:
         from strapdown.algorithms.precision import run_mp
 
-        return run_mp(motion, self.coefficient_set(spec), structure=_structure(spec), h=h,
-                      samples=samples, digits=digits)
+        return run_mp(motion, self.coefficient_set(spec),
+                      structure=increment_structure(spec.structure), h=h, samples=samples,
+                      digits=digits)
 
     def propagation(self, spec: AlgorithmSpec) -> dict[str, Any]:
         import numpy as np
@@ -97,15 +98,6 @@ class Rotvec(Family):
         return dict(is_rate=False, offsets=np.arange(n, dtype=np.int64), weights=np.ones(n),
                     pi=ii.astype(np.int64), pj=jj.astype(np.int64), pc=cs.matrix[ii, jj],
                     stride=n, span=n - 1, end_off=n, lag=1, start_c=0.0, rk4=False)
-
-
-def _structure(spec: AlgorithmSpec) -> IncrementStructure:
-    """The spec's structure, one of the increment structures (checked on construction)."""
-    s = spec.structure
-    if s == "sliding":
-        raise ValueError("rotvec runs in the conventional, realtime or single-chain structure, "
-                         "not 'sliding'")
-    return s
 
 
 #: The families this module defines, in registry order.

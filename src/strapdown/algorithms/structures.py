@@ -52,6 +52,7 @@ __all__ = [
     "TailPolicy",
     "chain_rotation_vectors",
     "conventional",
+    "increment_structure",
     "realtime",
     "run_structure",
     "single_chain",
@@ -231,6 +232,13 @@ def realtime(
     _kernels.realtime_kernel(theta, ks, q0, q)
     k = np.arange(theta.shape[0] + 1)
     return AttitudeSolution(t0 + k * h, q, "realtime", coefficients, h, h, k % n)
+
+
+def increment_structure(name: object) -> IncrementStructure:
+    """``name`` if it is an increment update structure, else ValueError listing them."""
+    if name not in STRUCTURES:
+        raise ValueError(f"unknown structure {name!r}; choose one of {', '.join(STRUCTURES)}")
+    return name
 
 
 def run_structure(name: IncrementStructure, increments: ArrayLike,

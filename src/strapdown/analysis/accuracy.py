@@ -11,6 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 from scipy.integrate import solve_ivp
 
 from strapdown._core.validation import (
@@ -22,6 +23,7 @@ from strapdown._core.validation import (
     positive_int,
 )
 from strapdown.algorithms.coning import table1_drift_constant
+from strapdown.algorithms.family import IncrementStructure
 from strapdown.rotation.error import attitude_error_angle, attitude_error_vector
 from strapdown.rotation.quaternion import quat_conjugate, quat_multiply
 from strapdown.truth.motions import Motion
@@ -45,7 +47,8 @@ PERIOD_TOLERANCE = 1e-6
 _CHUNK = 1_000_000
 
 
-def attitude_errors(t, q_est, motion: Motion) -> tuple[np.ndarray, np.ndarray]:
+def attitude_errors(t: ArrayLike, q_est: ArrayLike, motion: Motion
+                    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Reference-frame error vectors and angles of ``q_est`` against the motion's truth.
 
     Evaluated in chunks, so 10⁸-sample records need no more than a few
@@ -86,13 +89,13 @@ class DriftEstimate:
         Number of error samples used.
     """
 
-    rate: np.ndarray
+    rate: NDArray[np.float64]
     method: str
     points: int
 
 
-def drift_rate(t, err, *, period: float | None = None, reference_time: float | None = None,
-               h: float | None = None) -> DriftEstimate:
+def drift_rate(t: ArrayLike, err: ArrayLike, *, period: float | None = None,
+               reference_time: float | None = None, h: float | None = None) -> DriftEstimate:
     """Least-squares drift rate of an error series.
 
     Parameters
@@ -136,7 +139,8 @@ def drift_rate(t, err, *, period: float | None = None, reference_time: float | N
     return DriftEstimate(np.asarray(rate), method, int(ts.size))
 
 
-def chain_drift_rate(t, err, chain, *, period: float | None = None) -> tuple[DriftEstimate, ...]:
+def chain_drift_rate(t: ArrayLike, err: ArrayLike, chain: ArrayLike, *,
+                     period: float | None = None) -> tuple[DriftEstimate, ...]:
     """Drift of each interleaved chain of a multi-chain structure.
 
     Each chain is sampled at whole periods after its own first output, so its
@@ -155,7 +159,7 @@ def chain_drift_rate(t, err, chain, *, period: float | None = None) -> tuple[Dri
     return tuple(out)
 
 
-def sawtooth_amplitude(err, chain, window: int) -> np.ndarray:
+def sawtooth_amplitude(err: ArrayLike, chain: ArrayLike, window: int) -> NDArray[np.float64]:
     """Peak-to-peak N-periodic component of an error series, per window of samples.
 
     In each window the error is regressed on a linear trend plus one constant
@@ -178,7 +182,7 @@ def sawtooth_amplitude(err, chain, window: int) -> np.ndarray:
     return np.array(out)
 
 
-def accumulated_drift(q_est, q_true) -> np.ndarray:
+def accumulated_drift(q_est: ArrayLike, q_true: ArrayLike) -> NDArray[np.float64]:
     """Plaksiy's accumulated drift time series: ``2 |vec(Λ_true* ∘ Λ_est)|`` (rad).
 
     The vector part has the same norm in the body- and reference-frame error
@@ -204,7 +208,7 @@ def table1_prediction(half_angle: float, cone_rate: float, h: float, n: int) -> 
     return -c * half_angle**2 * cone_rate * (cone_rate * h) ** (2 * n)
 
 
-def update_period(structure: str, n: int, h: float) -> float:
+def update_period(structure: IncrementStructure, n: int, h: float) -> float:
     """Time between attitude outputs: ``N h`` (conventional) or ``h`` (real-time)."""
     n = positive_int(n, "N")
     h = positive(h, "h")
@@ -215,7 +219,7 @@ def update_period(structure: str, n: int, h: float) -> float:
     raise ValueError(f"unknown structure {structure!r}")
 
 
-def rotation_per_update(rate: float, structure: str, n: int, h: float) -> float:
+def rotation_per_update(rate: float, structure: IncrementStructure, n: int, h: float) -> float:
     """Rotation angle between outputs for a constant rate: ``|ω| · update_period`` (rad).
 
     This is what Li & Zhang 2017 Tables 4/5 call the "angular increment per update".
@@ -223,8 +227,8 @@ def rotation_per_update(rate: float, structure: str, n: int, h: float) -> float:
     return abs(float(finite_array(rate, "rate"))) * update_period(structure, n, h)
 
 
-def integrate_attitude_ode(motion: Motion, t, *, q0=None, rtol: float = 1e-13,
-                           atol: float = 1e-15) -> np.ndarray:
+def integrate_attitude_ode(motion: Motion, t: ArrayLike, *, q0: ArrayLike | None = None,
+                           rtol: float = 1e-13, atol: float = 1e-15) -> NDArray[np.float64]:
     """Integrate ``q̇ = ½ q ⊗ [0, ω_b]`` with DOP853 at ``rtol ≤ 1e-12``.
 
     An independent check of a motion's closed-form attitude (or of a
