@@ -22,11 +22,14 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--stream-samples", type=int, default=100_000_000)
     a = p.parse_args(argv)
     recs = bench.run_benchmarks(a.samples, stream_samples=a.stream_samples,
-                                ekf_samples=a.ekf_samples)
+                                ekf_samples=a.ekf_samples,
+                                log=lambda line: print(line, file=sys.stderr))
     write_text(Path(a.out), json.dumps(recs, indent=2))
     for r in recs:
         if "peak_rss_mb" in r:
             print(f"{r['name']:38s} peak RSS {r['peak_rss_mb']:.0f} MB")
+        elif r.get("skipped"):
+            print(f"{r['name']:38s} skipped: {r['skipped']}")
         elif r.get("samples_per_s"):
             print(f"{r['name']:38s} {r['samples_per_s']:11.3e}/s  "
                   f"{r['ratio_to_numpy_pass']:8.4f} × numpy  {r['peer'] or ''}")

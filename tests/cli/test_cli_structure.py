@@ -150,8 +150,10 @@ def fake_bench(monkeypatch):
 
     calls = []
 
-    def run_benchmarks(*args):
+    def run_benchmarks(*args, log=None):
         calls.append(args)
+        if log is not None:
+            log("[1/1] numpy-single-pass")
         return FAKE_RECORDS
 
     monkeypatch.setattr(bench, "run_benchmarks", run_benchmarks)

@@ -13,17 +13,50 @@ accelerometer and magnetometer updates at every output) runs on
 (per-sample Python calls into C) on the same data. Peak resident memory
 (VmHWM) of a 10⁸-sample stream is measured in a fresh subprocess; about
 140 MB of it is the interpreter with numpy, scipy and numba loaded.
+
+With a ``log``, each benchmark announces itself (``[k/total] name``) before it
+runs. A peer that is not installed is not dropped silently: its record has
+``skipped``, saying which package is missing and the extra that installs it.
 """
 
 from __future__ import annotations
 
+import importlib
 import subprocess
 import sys
 import time
+from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["run_benchmarks"]
+__all__ = ["PEER_EXTRA", "run_benchmarks"]
+
+#: How to install the peers (each skipped peer's record says it).
+PEER_EXTRA = "pip install 'strapdown[bench]'"
+
+
+@dataclass(frozen=True)
+class _Job:
+    """One benchmark: its record name, peer package (None: ours), timed function, sample
+    count and timed runs; ``fn`` None with ``skipped`` the reason: a peer that cannot run."""
+
+    name: str
+    peer: str | None
+    fn: Callable[[], object] | None
+    samples: int
+    repeat: int
+    skipped: str | None = None
+
+
+def _import_peer(package: str):
+    """``(module, None)``, or ``(None, why)`` when the peer cannot be imported."""
+    try:
+        return importlib.import_module(package), None
+    except ModuleNotFoundError:
+        return None, f"{package} not installed ({PEER_EXTRA})"
+    except ImportError as exc:  # installed but broken (a missing shared library, ...)
+        return None, f"{package} not importable: {exc}"
 
 
 def _best(fn, repeat):
@@ -37,6 +70,7 @@ def _best(fn, repeat):
 
 
 def _ours(samples, repeat):
+    """The NumPy floor's function and our algorithms' jobs on ``samples`` increments."""
     from strapdown.algorithms import rate
     from strapdown.algorithms.coning import coefficient_set
     from strapdown.algorithms.quaternion import QuaternionAlgorithm, quaternion_attitude
@@ -67,14 +101,8 @@ def _ours(samples, repeat):
         alg = QuaternionAlgorithm.stated(name)
         runs.append((f"{name}-conventional",
                      lambda alg=alg, m=m: quaternion_attitude(theta[:m], alg, step=3e-4)))
-    floor = samples / _best(lambda: (theta * 2.0).sum(axis=1), repeat)
-    recs = [{"name": "numpy-single-pass", "samples_per_s": floor, "ratio_to_numpy_pass": 1.0,
-             "peer": None}]
-    for name, fn in runs:
-        r = samples / _best(fn, repeat)
-        recs.append({"name": name, "samples_per_s": r, "ratio_to_numpy_pass": r / floor,
-                     "peer": None})
-    return recs, floor
+    floor = _Job("numpy-single-pass", None, lambda: (theta * 2.0).sum(axis=1), samples, repeat)
+    return floor, [_Job(name, None, fn, samples, repeat) for name, fn in runs]
 
 
 def _imu(samples):
@@ -92,47 +120,36 @@ def _imu(samples):
     return t, m.rate(t), acc, mag
 
 
-def _ahrs(samples, floor, repeat):
+def _ahrs(samples, repeat):
+    """Jobs of the AHRS EKF (each propagation algorithm) and of the AHRS peers."""
     from strapdown.ahrs import ekf
 
     t, w, acc, mag = _imu(samples)
-    recs = []
+    jobs = []
     for alg in ("rate-single", "rate-three", "rate-three:structure=sliding", "rk4",
                 "rotvec:N=3"):
-        r = samples / _best(lambda alg=alg: ekf(t, w, acc, mag, algorithm=alg), repeat)
         name = "ahrs-ekf-" + alg.replace(":structure=", "-").replace(":N=", "-N")
-        recs.append({"name": name, "samples_per_s": r, "ratio_to_numpy_pass": r / floor,
-                     "peer": None})
-    try:
-        import vqf
+        jobs.append(_Job(name, None, lambda alg=alg: ekf(t, w, acc, mag, algorithm=alg),
+                         samples, repeat))
+    vqf, why = _import_peer("vqf")
+    jobs.append(_Job("vqf-offline-9d", "vqf", vqf and (
+        lambda: vqf.offlineVQF(w, acc, mag, 1 / 200.0, {})), samples, repeat, why))
+    imufusion, why = _import_peer("imufusion")
+    few = min(samples, 50_000)
 
-        r = samples / _best(lambda: vqf.offlineVQF(w, acc, mag, 1 / 200.0, {}), repeat)
-        recs.append({"name": "vqf-offline-9d", "samples_per_s": r,
-                     "ratio_to_numpy_pass": r / floor, "peer": "vqf"})
-    except ImportError:
-        pass
-    try:
-        import imufusion
+    def fusion():
+        a = imufusion.Ahrs()
+        a.set_sample_period(1 / 200.0)
+        g, ag = np.degrees(w[:few]), acc[:few] / 9.80665
+        for i in range(few):
+            a.update(g[i], ag[i], mag[i])
 
-        few = min(samples, 50_000)
-
-        def fusion():
-            a = imufusion.Ahrs()
-            a.set_sample_period(1 / 200.0)
-            g, ag = np.degrees(w[:few]), acc[:few] / 9.80665
-            for i in range(few):
-                a.update(g[i], ag[i], mag[i])
-
-        r = few / _best(fusion, 1)
-        recs.append({"name": "imufusion-ahrs", "samples_per_s": r,
-                     "ratio_to_numpy_pass": r / floor, "peer": "imufusion"})
-    except ImportError:
-        pass
-    return recs
+    jobs.append(_Job("imufusion-ahrs", "imufusion", imufusion and fusion, few, 1, why))
+    return jobs
 
 
-def _peers(samples, floor):
-    recs = []
+def _peers(samples):
+    """Jobs of the per-sample attitude-update peers (timed once each)."""
     rng = np.random.default_rng(1)
     theta = rng.normal(size=(samples, 3)) * 1e-3
     from scipy.spatial.transform import Rotation
@@ -143,38 +160,40 @@ def _peers(samples, floor):
             r = r * Rotation.from_rotvec(th)
         return r
 
-    peers = [("scipy-rotation-loop", "scipy", scipy_loop)]
+    ahrs, why_ahrs = _import_peer("ahrs")
+    smsfusion, why_sms = _import_peer("smsfusion")
+
+    def sms():
+        ins = smsfusion.StrapdownINS(1e4, np.r_[np.zeros(6), 1.0, 0, 0, 0, np.zeros(6)])
+        f = np.array([0.0, 0.0, -9.80665])
+        for w in theta * 1e4:
+            ins.update(f, w)
+        return ins
+
+    return [
+        _Job("scipy-rotation-loop", "scipy", scipy_loop, samples, 1),
+        _Job("ahrs-angularrate", "ahrs", ahrs and (
+            lambda: ahrs.filters.AngularRate(gyr=theta * 1e4, frequency=1e4,
+                                             q0=np.array([1.0, 0, 0, 0]))),
+             samples, 1, why_ahrs),
+        _Job("smsfusion-strapdownins", "smsfusion", smsfusion and sms, samples, 1, why_sms),
+    ]
+
+
+def _record(job: _Job, floor: float | None) -> dict:
+    """Time ``job`` (the floor itself when ``floor`` is None) into its record."""
+    rec: dict = {"name": job.name, "samples_per_s": None, "ratio_to_numpy_pass": None,
+                 "peer": job.peer}
+    if job.fn is None:
+        return {**rec, "skipped": job.skipped}
     try:
-        import ahrs
-
-        peers.append(("ahrs-angularrate", "ahrs",
-                      lambda: ahrs.filters.AngularRate(gyr=theta * 1e4, frequency=1e4,
-                                                       q0=np.array([1.0, 0, 0, 0]))))
-    except ImportError:
-        pass
-    try:
-        import smsfusion
-
-        def sms():
-            ins = smsfusion.StrapdownINS(1e4, np.r_[np.zeros(6), 1.0, 0, 0, 0, np.zeros(6)])
-            f = np.array([0.0, 0.0, -9.80665])
-            for w in theta * 1e4:
-                ins.update(f, w)
-            return ins
-
-        peers.append(("smsfusion-strapdownins", "smsfusion", sms))
-    except ImportError:
-        pass
-    for name, pkg, fn in peers:
-        try:
-            r = samples / _best(fn, 1)
-        except Exception as exc:  # a peer's API drift must not sink the whole benchmark
-            recs.append({"name": name, "samples_per_s": None, "ratio_to_numpy_pass": None,
-                         "peer": pkg, "error": f"{type(exc).__name__}: {exc}"})
-            continue
-        recs.append({"name": name, "samples_per_s": r, "ratio_to_numpy_pass": r / floor,
-                     "peer": pkg})
-    return recs
+        r = job.samples / _best(job.fn, job.repeat)
+    except Exception as exc:  # a peer's API drift must not sink the whole benchmark
+        if job.peer is None:
+            raise
+        return {**rec, "error": f"{type(exc).__name__}: {exc}"}
+    return {**rec, "samples_per_s": r, "ratio_to_numpy_pass": 1.0 if floor is None
+            else r / floor}
 
 
 _STREAM_SCRIPT = """
@@ -208,14 +227,32 @@ def _stream_memory(total, structure, chunk=1 << 16):
 
 
 def run_benchmarks(samples: int = 10_000_000, peer_samples: int = 20_000, repeat: int = 3,
-                   stream_samples: int = 100_000_000, ekf_samples: int = 1_000_000) -> list[dict]:
-    """All benchmark records (see the module docstring)."""
-    recs, floor = _ours(samples, repeat)
-    recs += _peers(peer_samples, floor)
-    if ekf_samples:
-        recs += _ahrs(ekf_samples, floor, repeat)
-    if stream_samples:
-        for structure in ("conventional", "realtime"):
-            recs.append(_stream_memory(stream_samples, structure))
+                   stream_samples: int = 100_000_000, ekf_samples: int = 1_000_000, *,
+                   log: Callable[[str], None] | None = None) -> list[dict]:
+    """All benchmark records (see the module docstring).
+
+    ``log`` receives ``[k/total] name`` before each benchmark runs, and one line naming
+    the peers that are skipped and why, before the first.
+    """
+    say = log or (lambda _m: None)
+    floor_job, ours = _ours(samples, repeat)
+    jobs = [floor_job, *ours, *_peers(peer_samples), *(_ahrs(ekf_samples, repeat)
+                                                        if ekf_samples else ())]
+    streams = ("conventional", "realtime") if stream_samples else ()
+    skipped = [j for j in jobs if j.fn is None]
+    if skipped:
+        say("skipping " + "; ".join(f"{j.name}: {j.skipped}" for j in skipped))
+    total = len(jobs) - len(skipped) + len(streams)
+    done = 0
+    recs: list[dict] = []
+    for job in jobs:
+        if job.fn is not None:
+            done += 1
+            say(f"[{done}/{total}] {job.name}")
+        recs.append(_record(job, None if job is floor_job else recs[0]["samples_per_s"]))
+    for structure in streams:
+        done += 1
+        say(f"[{done}/{total}] stream-{structure}: peak memory of {stream_samples:.0e} samples")
+        recs.append(_stream_memory(stream_samples, structure))
     return recs
 

@@ -9,6 +9,8 @@ from __future__ import annotations
 import argparse
 import json
 
+from strapdown.cli._common import progress, progress_args, say
+
 __all__ = ["add_parser", "run"]
 
 
@@ -35,14 +37,16 @@ def _arguments(p: argparse.ArgumentParser) -> None:
                    help="samples for the AHRS EKF and its peers (0 skips them)")
     p.add_argument("--repeat", type=int, default=3, help="timed runs; the best is reported")
     p.add_argument("--json", action="store_true", help="print the records as JSON")
+    progress_args(p)
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run the benchmarks and print the table (or ``--json``)."""
+    """Run the benchmarks and print the table (or ``--json``); with progress, a line per
+    benchmark on stderr as it starts. Skipped peers are rows of the table (and records)."""
     from strapdown.apps.bench import run_benchmarks
 
     recs = run_benchmarks(args.samples, args.peer_samples, args.repeat, args.stream_samples,
-                          args.ekf_samples)
+                          args.ekf_samples, log=say if progress(args) else None)
     if args.json:
         print(json.dumps(recs, indent=2))
         return 0
@@ -50,6 +54,8 @@ def run(args: argparse.Namespace) -> int:
     for r in recs:
         if "peak_rss_mb" in r:
             print(f"{r['name']:34s} peak RSS {r['peak_rss_mb']:.0f} MB in {r['seconds']:.0f} s")
+        elif r.get("skipped"):
+            print(f"{r['name']:34s} skipped: {r['skipped']}")
         elif r["samples_per_s"] is None:
             print(f"{r['name']:34s} failed: {r['error']}")
         else:
