@@ -196,13 +196,16 @@ def log_check_args(p: argparse.ArgumentParser) -> None:
                    help="sensor range in the declared unit; saturated rows are reported")
 
 
-def progress_args(p: Options) -> None:
-    """``--progress`` / ``--no-progress``; neither: a bar when stderr is a terminal."""
+def progress_args(p: Options, what: str = "a progress bar") -> None:
+    """``--progress`` / ``--no-progress``; neither: ``what`` when stderr is a terminal.
+
+    ``what`` says what the command shows, e.g. ``"a line per table or figure"``.
+    """
     prog = p.add_mutually_exclusive_group()
     prog.add_argument("--progress", dest="progress", action="store_true", default=None,
-                      help="progress bar on stderr (default: when stderr is a terminal)")
+                      help=f"show {what} (on stderr; default: when stderr is a terminal)")
     prog.add_argument("--no-progress", dest="progress", action="store_false",
-                      help="no progress bar")
+                      help=f"do not show {what}")
 
 
 def progress(args: argparse.Namespace) -> bool:

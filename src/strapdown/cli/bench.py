@@ -37,7 +37,7 @@ def _arguments(p: argparse.ArgumentParser) -> None:
                    help="samples for the AHRS EKF and its peers (0 skips them)")
     p.add_argument("--repeat", type=int, default=3, help="timed runs; the best is reported")
     p.add_argument("--json", action="store_true", help="print the records as JSON")
-    progress_args(p)
+    progress_args(p, "a line as each benchmark starts")
 
 
 def run(args: argparse.Namespace) -> int:

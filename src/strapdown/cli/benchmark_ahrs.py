@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from strapdown.cli._common import say
+from strapdown.cli._common import progress, progress_args, say
 
 __all__ = ["add_parser", "run"]
 
@@ -26,13 +26,15 @@ def _arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", default="reports/benchmark-ahrs", help="output directory")
     p.add_argument("--algorithm", default="rate-single",
                    help="our propagation algorithm (a spec, as for strapdown ahrs)")
+    progress_args(p, "a line as each trial and filter runs")
 
 
 def run(args: argparse.Namespace) -> int:
     """Run the benchmark and print each filter's mean total RMSE."""
     from strapdown.apps.ahrs_benchmark import FILTERS, benchmark, mean_total
 
-    res = benchmark(args.dir, args.out, algorithm=args.algorithm, progress=say)
+    res = benchmark(args.dir, args.out, algorithm=args.algorithm,
+                    progress=say if progress(args) else None)
     for f in FILTERS:
         m = mean_total(res, f)
         if m == m:  # NaN: the filter did not run (peer not installed)

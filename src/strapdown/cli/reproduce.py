@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from strapdown.cli._common import say
+from strapdown.cli._common import progress, progress_args, say
 
 __all__ = ["add_parser", "run"]
 
@@ -26,12 +26,14 @@ def _arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("paper", choices=tuple(REPRODUCTIONS),
                    help="; ".join(f"{name}: {r.subject}" for name, r in REPRODUCTIONS.items()))
     p.add_argument("--out", required=True, help="output directory (created; files replaced)")
+    progress_args(p, "a line as each table or figure starts")
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run the reproduction and print where its report is."""
+    """Run the reproduction and print where its report is; with progress, a line on stderr
+    as each table or figure starts."""
     from strapdown.reproduce import reproduction
 
-    path = reproduction(args.paper).reproduce(args.out, progress=say)
+    path = reproduction(args.paper).reproduce(args.out, progress=say if progress(args) else None)
     print(f"wrote {path}")
     return 0
