@@ -14,18 +14,20 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from strapdown.rotation.quaternion import quat_conjugate, quat_multiply
 
 __all__ = ["broad_errors"]
 
 
-def _twist_z(q) -> np.ndarray:
+def _twist_z(q: NDArray[np.float64]) -> NDArray[np.float64]:
     """Rotation angle of the twist of q about the vertical (rad, in (−π, π])."""
     return 2.0 * np.arctan2(q[..., 3], q[..., 0])
 
 
-def broad_errors(q_est, q_ref, movement, *, heading_offset: bool = True) -> dict:
+def broad_errors(q_est: ArrayLike, q_ref: ArrayLike, movement: ArrayLike, *,
+                 heading_offset: bool = True) -> dict[str, float]:
     """BROAD's total, heading and inclination RMSE (degrees) over movement phases.
 
     Parameters

@@ -20,7 +20,8 @@ import math
 
 import numpy as np
 
-from strapdown.algorithms.coning import coefficient_set
+from strapdown.algorithms.coning import ConingSetName, coefficient_set
+from strapdown.algorithms.family import IncrementStructure
 from strapdown.algorithms.precision import run_mp
 from strapdown.algorithms.structures import run_structure
 from strapdown.analysis.accuracy import attitude_errors, chain_drift_rate
@@ -36,8 +37,9 @@ DIGITS = 50
 
 
 @functools.lru_cache(maxsize=512)
-def drift_mp(a: float, spp: int, n: int, structure: str, coefficients: str = "table3",
-             periods: int = 2, digits: int = DIGITS) -> float:
+def drift_mp(a: float, spp: int, n: int, structure: IncrementStructure,
+             coefficients: ConingSetName = "table3", periods: int = 2,
+             digits: int = DIGITS) -> float:
     """Cone-axis drift (rad/s) in arbitrary precision, mean over the interleaved chains.
 
     Parameters
@@ -50,7 +52,7 @@ def drift_mp(a: float, spp: int, n: int, structure: str, coefficients: str = "ta
     n : int
         Subsamples N.
     structure : {"conventional", "realtime", "single-chain"}
-    coefficients : str
+    coefficients : ConingSetName
         A named set of :func:`strapdown.algorithms.coning.coefficient_set`.
     periods : int
         Cone periods simulated.
@@ -81,7 +83,8 @@ def drift_mp(a: float, spp: int, n: int, structure: str, coefficients: str = "ta
 
 
 @functools.lru_cache(maxsize=64)
-def drift_f64(a: float, spp: int, n: int, structure: str, periods: int = 20) -> float:
+def drift_f64(a: float, spp: int, n: int, structure: IncrementStructure,
+              periods: int = 20) -> float:
     """Cone-axis drift (rad/s) in float64, Table 3 coefficients, mean over the chains.
 
     Same pipeline as ``strapdown evaluate``: float64 increments from the closed form,

@@ -10,21 +10,36 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass, field
+from typing import Any, Literal, get_args
 
 import numpy as np
+from numpy.typing import NDArray
 
 from strapdown import analysis
+from strapdown._core.kinds import InputKind
 from strapdown._core.validation import positive, positive_int
 from strapdown.algorithms.coning import CoefficientSet
+from strapdown.algorithms.family import AlgorithmName, Rk4Step, StructureName
 from strapdown.algorithms.precision import run_mp
-from strapdown.algorithms.spec import AlgorithmSpec, algorithms_taking
-from strapdown.algorithms.structures import run_structure
+from strapdown.algorithms.spec import AlgorithmSpec, CoefficientName, algorithms_taking
+from strapdown.algorithms.structures import increment_structure, run_structure
+from strapdown.analysis.law import LawResolution, judge_law
 from strapdown.truth import sensors
 from strapdown.truth.motions import ClassicalConing, KrylovMotion, Motion, PureSpin, SpinConing
 
-__all__ = ["MOTIONS", "Evaluation", "EvaluationConfig", "build_motion", "evaluate"]
+__all__ = ["METRICS", "MOTIONS", "Evaluation", "EvaluationConfig", "MetricName", "MotionName",
+           "build_motion", "evaluate"]
 
-MOTIONS = ("coning", "spin", "spin-coning", "krylov")
+#: The reference motions an evaluation runs on (see :func:`build_motion`).
+MotionName = Literal["coning", "spin", "spin-coning", "krylov"]
+MOTIONS: tuple[MotionName, ...] = get_args(MotionName)
+#: The numerical results of an evaluation: keys of :meth:`Evaluation.to_dict` a sweep may
+#: tabulate.
+MetricName = Literal["max_error_rad", "rms_error_rad", "cone_axis_drift_rad_s",
+                     "predicted_drift_rad_s", "drift_rate_rad_s", "accumulated_drift_rad",
+                     "update_period_s", "samples", "chain_cone_axis_drift_rad_s",
+                     "drift_points"]
+METRICS: tuple[MetricName, ...] = get_args(MetricName)
 RATE_ALGORITHMS = algorithms_taking("rate")
 
 
@@ -41,17 +56,17 @@ class EvaluationConfig:
     designer's set, quadrature error included); ``rk4`` has none.
     """
 
-    motion: str = "coning"
+    motion: MotionName = "coning"
     half_angle_deg: float = 1.0
     cone_rate_hz: float = 1.0
     spin_rate_dps: float = 0.0
     sample_rate_hz: float = 10_000.0
     duration: float = 2.0
-    algorithm: str = "rotvec"
+    algorithm: AlgorithmName = "rotvec"
     subsamples: int = 3
-    coefficients: str | None = None
-    structure: str = "conventional"
-    rk4_step: str = "2td"
+    coefficients: CoefficientName | None = None
+    structure: StructureName = "conventional"
+    rk4_step: Rk4Step = "2td"
     krylov_rates: tuple[float, float, float] = (0.15, 0.25, 0.05)
     alpha: float | None = None
     beta: float | None = None
@@ -101,14 +116,20 @@ class EvaluationConfig:
         return 1.0 / self.sample_rate_hz
 
     @property
-    def resolved_coefficients(self) -> str | None:
+    def resolved_coefficients(self) -> CoefficientName | None:
         return self.spec.resolved_coefficients
+
+    def _step(self) -> float:
+        """The computation step ΔT (s) of the quaternion algorithms (ValueError without one)."""
+        if self.step is None:
+            raise ValueError(f"{self.algorithm} needs --step (the computation step ΔT, s)")
+        return self.step
 
     @property
     def samples(self) -> int:
         spec = self.spec
         if spec.family.stepped:  # whole computation steps of sub-interval increments
-            steps = round(self.duration / self.step)
+            steps = round(self.duration / self._step())
             if steps < 1:
                 raise ValueError(f"duration {self.duration} s is shorter than one step")
             return steps * spec.min_samples
@@ -151,17 +172,17 @@ class Evaluation:
     """Result of :func:`evaluate` (rad, s)."""
 
     config: EvaluationConfig
-    t: np.ndarray
-    err: np.ndarray
-    angle: np.ndarray
-    chain: np.ndarray
+    t: NDArray[np.float64]
+    err: NDArray[np.float64]
+    angle: NDArray[np.float64]
+    chain: NDArray[np.int_]
     drift: analysis.DriftEstimate
     chain_drifts: tuple[analysis.DriftEstimate, ...]
-    cone_axis: np.ndarray | None
+    cone_axis: NDArray[np.float64] | None
     predicted: float | None
     update_period: float
     samples: int
-    accumulated: np.ndarray | None = None
+    accumulated: NDArray[np.float64] | None = None
 
     @property
     def cone_axis_drift(self) -> float | None:
@@ -169,7 +190,7 @@ class Evaluation:
             return None
         return float(self.drift.rate @ self.cone_axis)
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
         """The documented JSON record."""
         c = self.config
         return {
@@ -194,16 +215,30 @@ class Evaluation:
             "samples": self.samples,
             "accumulated_drift_rad": (None if self.accumulated is None
                                       else float(self.accumulated.max())),
+            **self._law_keys(),
             **self._quaternion_coefficients(),
         }
 
-    def _quaternion_coefficients(self) -> dict:
+    def law(self) -> LawResolution:
+        """Whether the measured/law ratio means anything (:func:`~.law.judge_law`)."""
         c = self.config
-        if not c.spec.family.stepped:
-            return {}
-        from strapdown.algorithms.quaternion import STATED
+        return judge_law(self.cone_axis_drift, self.predicted,
+                         half_angle=math.radians(c.half_angle_deg), duration=c.duration,
+                         digits=c.precision, ideal_gyro=c.gyro is None or c.gyro.is_ideal)
 
-        a0, b0 = STATED[c.algorithm]
+    def _law_keys(self) -> dict[str, Any]:
+        res = self.law()
+        return {"measured_over_law": res.ratio, "law_status": res.status,
+                "law_floor_rad_s": res.floor, "law_note": res.note or None}
+
+    def _quaternion_coefficients(self) -> dict[str, Any]:
+        from strapdown.algorithms.quaternion import ALGORITHMS, STATED
+
+        c = self.config
+        name = c.algorithm
+        if not c.spec.family.stepped or name not in ALGORITHMS:
+            return {}
+        a0, b0 = STATED[name]
         return {"alpha": a0 if c.alpha is None else c.alpha,
                 "beta": (b0 if c.beta is None else c.beta) if c.algorithm == "miller" else None,
                 "exact_exp": c.exact_exp, "step_s": c.step}
@@ -235,12 +270,13 @@ def evaluate(cfg: EvaluationConfig, *, coefficients: CoefficientSet | None = Non
         t, chain, start = sol.t, sol.chain, sol.startup
     law = spec.drift_law()
     predicted = None
-    if cfg.motion == "coning" and law is not None:
+    if isinstance(motion, ClassicalConing) and law is not None:  # cfg.motion == "coning"
         predicted = law.predict(motion.half_angle, motion.cone_rate, h)
     return _finish(cfg, motion, t, err, ang, chain, start, predicted, spec.update_period(h), n)
 
 
-def _gyro(cfg: EvaluationConfig, motion: Motion, kind: str, h: float, n: int):
+def _gyro(cfg: EvaluationConfig, motion: Motion, kind: InputKind, h: float,
+          n: int) -> sensors.GyroRecord:
     if kind == "rate":
         return sensors.rate_samples(motion, h, n, errors=cfg.gyro, rng=cfg.seed)
     return sensors.increments(motion, h, n, errors=cfg.gyro, rng=cfg.seed)
@@ -255,15 +291,17 @@ def _evaluate_user_set(cfg: EvaluationConfig, motion: Motion, cs: CoefficientSet
         raise ValueError(f"coefficient set has N = {cs.n}, configuration says {cfg.subsamples}")
     h, n = cfg.h, cfg.samples
     if cfg.precision is not None:
-        s = run_mp(motion, cs, structure=cfg.structure, h=h, samples=n, digits=cfg.precision)
+        s = run_mp(motion, cs, structure=increment_structure(cfg.structure), h=h, samples=n,
+                   digits=cfg.precision)
         t, err, ang, chain, start = s.t, s.err, s.angle, s.chain, s.startup
     else:
         rec = sensors.increments(motion, h, n, errors=cfg.gyro, rng=cfg.seed)
-        sol = run_structure(cfg.structure, rec.data, cs, h=h, q0=motion.attitude(0.0))
+        sol = run_structure(increment_structure(cfg.structure), rec.data, cs, h=h,
+                            q0=motion.attitude(0.0))
         err, ang = analysis.attitude_errors(sol.t, sol.q, motion)
         t, chain, start = sol.t, sol.chain, sol.startup
     predicted = None
-    if cfg.motion == "coning" and cs.classical_optimum:
+    if isinstance(motion, ClassicalConing) and cs.classical_optimum:  # cfg.motion == "coning"
         predicted = analysis.table1_prediction(motion.half_angle, motion.cone_rate, h, cs.n)
     return _finish(cfg, motion, t, err, ang, chain, start, predicted,
                    cfg.spec.update_period(h), n)
@@ -272,13 +310,13 @@ def _evaluate_user_set(cfg: EvaluationConfig, motion: Motion, cs: CoefficientSet
 def _evaluate_quaternion(cfg: EvaluationConfig, motion: Motion) -> Evaluation:
     spec = cfg.spec
     n = cfg.samples
-    rec = sensors.increments(motion, cfg.step / spec.min_samples, n, errors=cfg.gyro,
+    rec = sensors.increments(motion, cfg._step() / spec.min_samples, n, errors=cfg.gyro,
                              rng=cfg.seed)
-    sol = spec.run_increments(rec.data, h=cfg.step / spec.min_samples,
+    sol = spec.run_increments(rec.data, h=cfg._step() / spec.min_samples,
                               q0=motion.attitude(0.0))
     err, ang = analysis.attitude_errors(sol.t, sol.q, motion)
     acc = analysis.accumulated_drift(sol.q, motion.attitude(sol.t))
-    ev = _finish(cfg, motion, sol.t, err, ang, sol.chain, 0, None, cfg.step, n)
+    ev = _finish(cfg, motion, sol.t, err, ang, sol.chain, 0, None, cfg._step(), n)
     return dataclasses.replace(ev, accumulated=acc)
 
 
