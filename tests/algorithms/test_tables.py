@@ -68,3 +68,15 @@ def test_run_evaluate_and_ahrs_paths_never_import_sympy_or_matplotlib():
     out = subprocess.run([sys.executable, "-c", _NO_SYMPY], capture_output=True, text=True,
                          check=True).stdout.strip().splitlines()[-1]
     assert out == "none"
+
+
+@pytest.mark.parametrize("n", sorted(tables.SCULLING_CONVENTIONAL))
+def test_sculling_tables_are_the_designers(n):
+    from strapdown.design import interval_structure
+
+    conv = derive(interval_structure(n), target="sculling")
+    chain = derive(single_chain_structure(n), target="sculling")
+    assert conv.coefficients == tables.SCULLING_CONVENTIONAL[n]
+    assert chain.coefficients == tables.SCULLING_SINGLE_CHAIN[n]
+    assert (conv.order, conv.drift_constant) == tables.SCULLING_DRIFT[n]
+    assert (chain.order, chain.drift_constant) == tables.SCULLING_DRIFT[n]

@@ -20,6 +20,9 @@ __all__ = [
     "RATE_THREE",
     "RATE_THREE_DRIFT",
     "RK4_DRIFT",
+    "SCULLING_CONVENTIONAL",
+    "SCULLING_DRIFT",
+    "SCULLING_SINGLE_CHAIN",
     "SINGLE_CHAIN",
 ]
 
@@ -58,3 +61,42 @@ RATE_THREE_DRIFT: dict[RateCoefficients, tuple[int, F]] = {"derived": (8, F(433,
 #: Quaternion RK4 on q̇ = ½ q ⊗ ω: (order, c) per step variant, derived symbolically by
 #: :func:`strapdown.design.rk4_classical_coning_drift`.
 RK4_DRIFT: dict[Rk4Step, tuple[int, F]] = {"2td": (4, F(-1, 60)), "td-interp": (2, F(1, 12))}
+
+#: Sculling compensation of the conventional structure, ``Σ_m ς_m (θ_{N−m} × v_N +
+#: v_{N−m} × θ_N)``: ς_1 … ς_{N−1} (lag m = 1, 2, …) from
+#: ``derive(interval_structure(N), target="sculling")``, for N = 1 … 6. They equal the
+#: classical-coning optimum of the same structure, Li & Zhang (2017) Table 3 (Ignagni's
+#: duality, Ignagni (1998)).
+SCULLING_CONVENTIONAL: dict[int, tuple[F, ...]] = {
+    1: (),
+    2: (F(2, 3),),
+    3: (F(27, 20), F(9, 20)),
+    4: (F(214, 105), F(92, 105), F(18, 35)),
+    5: (F(1375, 504), F(325, 252), F(25, 24), F(125, 252)),
+    6: (F(15797, 4620), F(3917, 2310), F(608, 385), F(2279, 2310), F(463, 924)),
+}
+
+#: Sculling compensation of the single chain, ``Σ_m c_m (θ_{k−m} × v_k + v_{k−m} × θ_k)``:
+#: c_1 … c_{N−1} from ``derive(single_chain_structure(N), target="sculling")`` (equal to
+#: :data:`SINGLE_CHAIN`).
+SCULLING_SINGLE_CHAIN: dict[int, tuple[F, ...]] = {
+    1: (),
+    2: (F(1, 12),),
+    3: (F(7, 60), F(-1, 60)),
+    4: (F(113, 840), F(-13, 420), F(1, 280)),
+    5: (F(367, 2520), F(-53, 1260), F(1, 120), F(-1, 1260)),
+    6: (F(4247, 27720), F(-703, 13860), F(61, 4620), F(-31, 13860), F(1, 5544)),
+}
+
+#: Classical-sculling law of both structures with these sets: (order, c) with the rectified
+#: velocity error rate ``−c · θ0 A cos ψ (Ωh)^order`` along the axis normal to the angular
+#: and linear vibration (leading order in θ0; ``h`` the sample interval). The coning
+#: drift constants of Li & Zhang (2017) Table 1, ``N!(N+1)!/(2N+2)!``.
+SCULLING_DRIFT: dict[int, tuple[int, F]] = {
+    1: (2, F(1, 12)),
+    2: (4, F(1, 60)),
+    3: (6, F(1, 280)),
+    4: (8, F(1, 1260)),
+    5: (10, F(1, 5544)),
+    6: (12, F(1, 24024)),
+}

@@ -28,8 +28,9 @@ def _arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--subsamples", type=int, required=True,
                    help="N, increments (or rate samples) per update")
     p.add_argument("--target", choices=TARGETS, default="coning",
-                   help="design target: coning (the highest order of classical-coning drift) "
-                   "or polynomial (polynomial-rate conditions, lowest degrees first)")
+                   help="design target: coning (the highest order of classical-coning drift), "
+                   "polynomial (polynomial-rate conditions, lowest degrees first) or sculling "
+                   "(the highest order of classical-sculling velocity error; increment input)")
     p.add_argument("--rule", choices=RULES, default="polynomial",
                    help="how to settle coefficients the target leaves free")
     p.add_argument("--previous", type=int, default=None,
@@ -63,7 +64,11 @@ def run(args: argparse.Namespace) -> int:
         lines.append(f"  {term:{width}s}  {frac:>14s}  {dec: .17g}")
     if not rec["terms"]:
         lines.append("  (no cross-product terms)")
-    lines.append(f"drift         {_law(d.drift_constant, d.order)} about the cone axis")
+    if args.target == "sculling":
+        lines.append(f"velocity      {_law(d.drift_constant, d.order, 'θ0 A cos ψ')} rectified "
+                     "velocity error rate, normal to both vibrations")
+    else:
+        lines.append(f"drift         {_law(d.drift_constant, d.order)} about the cone axis")
     if true_drift is not None:
         order, const = true_drift
         lines.append(f"true drift    {_law(const, order)} (with the quadrature error)")
@@ -75,9 +80,9 @@ def _fraction(f) -> str:
     return f"{f.numerator}/{f.denominator}"
 
 
-def _law(const, order) -> str:
+def _law(const, order, amplitude: str = "a²Ω") -> str:
     """``drift = −c · a²Ω(Ωh)^order`` written with its sign resolved."""
     if order is None:
         return "none up to the series length examined"
     sign = "−" if const > 0 else "+"
-    return f"{sign}{_fraction(abs(const))} · a²Ω(Ωh)^{order}"
+    return f"{sign}{_fraction(abs(const))} · {amplitude}(Ωh)^{order}"

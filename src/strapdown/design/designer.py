@@ -15,6 +15,16 @@ Targets
 ``polynomial``
     Match the second-order Bortz term ``½∫α×ω`` exactly for angular rates
     that are polynomials in time of degree < number of nodes (Miller 1983).
+``sculling``
+    Cancel the rectified velocity error of classical sculling (angular oscillation
+    ``θ0 sin Ωt`` about one body axis, linear ``A sin(Ωt + ψ)`` along another) in the
+    velocity update ``Δv = υ + ½ α × υ + Σ_{i<j} k_ij (θ_i × v_j + v_i × θ_j)``
+    (Savage (1998b); Ignagni (1998)); increment input only. Its error series is derived
+    on its own (:func:`_sculling_series`) and turns out equal, term for term, to the
+    classical-coning series: the designed sculling coefficients are the coning ones
+    (Ignagni's duality), with the law
+    ``rectified velocity error rate = −c · θ0 A cos ψ (Ωh)^order`` along the axis normal
+    to both vibrations, ``c`` and ``order`` those of the coning drift.
 
 Classical-coning analysis (leading order in the half-cone angle ``a``)
 ---------------------------------------------------------------------
@@ -77,7 +87,7 @@ __all__ = [
 ]
 
 F = Fraction
-TARGETS = ("coning", "polynomial")
+TARGETS = ("coning", "polynomial", "sculling")
 RULES = ("polynomial", "min-norm")
 LAYOUTS = ("all-pairs", "cross-with-last", "lag")
 
@@ -347,6 +357,41 @@ def _coning_series(st: Structure, m: int, *, quadrature: bool = True):
     return e0, pair
 
 
+def _sculling_series(st: Structure, m: int):
+    """Rectified sculling velocity error per update over ``θ0 A cos ψ / Ω``, as series in x.
+
+    Classical sculling, first order in θ0 (Savage (1998b); Ignagni (1998)): with
+    ``d_n = e^{i s_n x}(e^{ix} − 1)`` the gyro and accelerometer increments of node ``n``
+    are ``θ_n = θ0 Im(e^{iφ} d_n)`` and ``v_n = (A/Ω) Im(−i e^{iψ} e^{iφ} d_n)`` (φ the
+    phase at the update start). Averaged over φ, a pair term ``k (θ_i × v_j + v_i × θ_j)``
+    contributes ``−k Im(d_i conj(d_j))`` along the normal axis, the rotation compensation
+    ``½ α × υ`` contributes ``¼ |D|² sin ψ`` (``D = Σ w_n d_n``) and the exact
+    ``∫ (α(t) − α_0) × f`` contributes ``½ [cos ψ (Ux − sin Ux) + sin ψ (1 − cos Ux)]``:
+    the sin ψ parts cancel when the weighted increments tile the update
+    (``½|D|² = 1 − cos Ux``), which is checked, and what remains is
+    ``e0 = −½ (Ux − sin Ux)`` and one series per pair.
+    """
+    if st.input != "increment":
+        raise ValueError("the sculling target is derived for increment input only; "
+                         f"{st.name!r} takes rate samples")
+    u = F(st.update)
+    re, im = [], []
+    for s in st.nodes:
+        re.append(_add(_cos(s + 1, m), _scale(_cos(s, m), -1)))
+        im.append(_add(_sin(s + 1, m), _scale(_sin(s, m), -1)))
+    pair = [_add(_mul(re[i], im[j], m), _scale(_mul(im[i], re[j], m), -1))
+            for i, j in st.pairs]  # −Im(d_i conj d_j) = Re d_i Im d_j − Im d_i Re d_j
+    d_re = _add(*[_scale(r, w) for r, w in zip(re, st.weights, strict=True)])
+    d_im = _add(*[_scale(r, w) for r, w in zip(im, st.weights, strict=True)])
+    half_d2 = _scale(_add(_mul(d_re, d_re, m), _mul(d_im, d_im, m)), F(1, 2))
+    if half_d2 != _add([F(1)] + [F(0)] * m, _scale(_cos(u, m), -1)):
+        raise ValueError(f"{st.name!r}: the weighted increments do not tile the update, "
+                         "so the sculling series has no closed form here")
+    e0 = _scale(_add(_shift(_scale([F(1)] + [F(0)] * m, u), 1), _scale(_sin(u, m), -1)),
+                F(-1, 2))
+    return e0, pair
+
+
 def _poly_conditions(st: Structure):
     """Rows (per pair) and targets of the polynomial-rate conditions, lowest degree first."""
     k = len(st.nodes)
@@ -432,7 +477,7 @@ class Design:
     Attributes
     ----------
     structure : Structure
-    target : {"coning", "polynomial"}
+    target : {"coning", "polynomial", "sculling"}
     rule : str
         How remaining freedom was settled.
     coefficients : tuple of Fraction
@@ -506,9 +551,14 @@ class Design:
             "terms": list(self.terms),
             "drift_constant": None if self.drift_constant is None else _fs(self.drift_constant),
             "order": self.order,
-            "drift_law": "drift about the cone axis = −drift_constant · a²Ω(Ωh)^order",
+            "drift_law": (_SCULLING_LAW if self.target == "sculling" else
+                          "drift about the cone axis = −drift_constant · a²Ω(Ωh)^order"),
             "quadrature_included": self.quadrature_included,
         }
+
+
+_SCULLING_LAW = ("rectified velocity error rate along the axis normal to both vibrations = "
+                 "−drift_constant · θ0 A cos ψ (Ωh)^order")
 
 
 def _leading(st, coeffs, e0, pair_series, m):
@@ -610,7 +660,8 @@ def derive(structure: Structure, *, target: str = "coning", rule: str = "polynom
     Parameters
     ----------
     structure : Structure
-    target : {"coning", "polynomial"}
+    target : {"coning", "polynomial", "sculling"}
+        ``sculling``: increment structures only (ValueError for rate input).
     rule : {"polynomial", "min-norm"}
         How to settle coefficients the target leaves free.
     quadrature : bool
@@ -639,7 +690,10 @@ def _derive(st: Structure, target: str, rule: str, quadrature: bool) -> Design:
         for k, mult in members:
             g[k][col] += mult
     m = 2 * ng + 2 * max(len(st.nodes), 2) + 9
-    e0, pair_series = _coning_series(st, m, quadrature=quadrature)
+    if target == "sculling":
+        e0, pair_series = _sculling_series(st, m)
+    else:
+        e0, pair_series = _coning_series(st, m, quadrature=quadrature)
     grp_series = [[sum(g[k][col] * pair_series[k][p] for k in range(npair)) for p in range(m + 1)]
                   for col in range(ng)]
     con_rows = [[grp_series[c][p] for c in range(ng)] for p in range(m + 1)]
@@ -647,7 +701,7 @@ def _derive(st: Structure, target: str, rule: str, quadrature: bool) -> Design:
     poly_rows_p, poly_rhs, _ = _poly_conditions(st)
     poly_rows = [[sum(r[k] * g[k][c] for k in range(npair)) for c in range(ng)]
                  for r in poly_rows_p]
-    if target == "coning":
+    if target in ("coning", "sculling"):
         a, b = _prefix_solve(con_rows, con_rhs)
         conditions = len(a)
         if rule == "polynomial":
@@ -659,5 +713,5 @@ def _derive(st: Structure, target: str, rule: str, quadrature: bool) -> Design:
     ug = [_frac(v) for v in u]
     coeffs = tuple(sum(g[k][c] * ug[c] for c in range(ng)) for k in range(npair))
     order, const = _leading(st, coeffs, e0, pair_series, m)
-    rule_used = rule if target == "coning" else "min-norm"
+    rule_used = rule if target in ("coning", "sculling") else "min-norm"
     return Design(st, target, rule_used, coeffs, order, const, quadrature, conditions)
