@@ -10,28 +10,46 @@ the input file is never overwritten.
 
 from __future__ import annotations
 
+import os
 import sys
 import warnings
+from collections.abc import Iterator, Sequence
 from pathlib import Path
+from typing import Any, Literal, get_args
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 from tqdm import tqdm
 
+from strapdown._core.kinds import InputKind
 from strapdown._core.validation import first_bad_step
-from strapdown.algorithms.spec import AlgorithmSpec, algorithms_taking
+from strapdown.algorithms.coning import CoefficientSet
+from strapdown.algorithms.family import AlgorithmName, IncrementStructure, StructureName
+from strapdown.algorithms.rotvec import Rotvec
+from strapdown.algorithms.spec import AlgorithmSpec, CoefficientName, algorithms_taking
 from strapdown.algorithms.streaming import RotvecStream
+from strapdown.algorithms.structures import increment_structure
 from strapdown.io import read_imu
 from strapdown.io.files import atomic_path
+from strapdown.io.readers import GapPolicy, GyroUnit
 from strapdown.rotation.cone_angles import cone_angles_from_quat
 from strapdown.rotation.dcm import dcm_from_quat
 from strapdown.rotation.euler import euler_zyx_from_dcm
 
-__all__ = ["run_log"]
+__all__ = ["ANGLES", "RUN_GAP_POLICIES", "AngleOutput", "RunGapPolicy", "run_log"]
 
 CHUNK = 1 << 16
 
+#: Angles written beside the quaternion: yaw/pitch/roll (z-y-x), cone angles, or none.
+AngleOutput = Literal["ypr", "cone", "none"]
+ANGLES: tuple[AngleOutput, ...] = get_args(AngleOutput)
+#: What ``run`` does at a gap: the reader's policies, or ``split`` (each gap-free segment
+#: runs on its own).
+RunGapPolicy = Literal[GapPolicy, "split"]
+RUN_GAP_POLICIES: tuple[RunGapPolicy, ...] = get_args(RunGapPolicy)
 
-def _angles(q, kind):
+
+def _angles(q: NDArray[np.float64], kind: AngleOutput) -> dict[str, NDArray[np.float64]]:
     if kind == "ypr":
         y, p, r = euler_zyx_from_dcm(dcm_from_quat(q))
         return {"yaw_deg": np.degrees(y), "pitch_deg": np.degrees(p), "roll_deg": np.degrees(r)}
@@ -42,17 +60,20 @@ def _angles(q, kind):
     return {}
 
 
-def _rows(t, q, angles):
+def _rows(t: NDArray[np.float64], q: NDArray[np.float64],
+          angles: AngleOutput) -> NDArray[np.float64]:
     cols = [t, q[:, 0], q[:, 1], q[:, 2], q[:, 3], *_angles(q, angles).values()]
     return np.column_stack(cols)
 
 
-def _header(angles):
+def _header(angles: AngleOutput) -> str:
     names = ["t", "qw", "qx", "qy", "qz", *_angles(np.array([[1.0, 0, 0, 0]]), angles)]
     return ",".join(names)
 
 
-def _npy_chunks(path: Path, units: str, read: dict, gaps: list, saturated: list):
+def _npy_chunks(path: Path, units: GyroUnit, read: dict[str, Any], gaps: list[int],
+                saturated: list[int]
+                ) -> Iterator[tuple[NDArray[np.float64], NDArray[np.float64]]]:
     """Validated (t, increments) chunks of an (n, 4) .npy log, memory-mapped.
 
     Gaps (intervals over ``gap_tolerance`` times the first interval — a
@@ -75,8 +96,8 @@ def _npy_chunks(path: Path, units: str, read: dict, gaps: list, saturated: list)
         first = 1 if last is None else 0  # data row (1-based) of t[0] is s + first
         fault = first_bad_step(d)
         if fault is not None:
-            i, what = fault
-            raise ValueError(f"{path}: {what} time stamp in data row {s + i + first + 1}")
+            k, what = fault
+            raise ValueError(f"{path}: {what} time stamp in data row {s + k + first + 1}")
         if h is None and d.size:
             h = float(d[0])
         if h is not None:
@@ -93,11 +114,15 @@ def _npy_chunks(path: Path, units: str, read: dict, gaps: list, saturated: list)
         yield c[:, 0], c[:, 1:] * scale
 
 
-def run_log(imu, out, *, kind: str, units: str | None, algorithm: str = "rotvec",
-            structure: str = "conventional", subsamples: int = 3, coefficients=None,
-            columns=("t", "gx", "gy", "gz"), sample_rate_hz=None, angles: str = "ypr",
-            q0=None, on_gap: str = "report", gap_tolerance: float = 1.5,
-            saturation: float | None = None, progress: bool = False) -> dict:
+def run_log(imu: str | os.PathLike[str], out: str | os.PathLike[str], *, kind: InputKind,
+            units: GyroUnit | None, algorithm: AlgorithmName = "rotvec",
+            structure: StructureName = "conventional", subsamples: int = 3,
+            coefficients: CoefficientName | None = None,
+            columns: Sequence[str] = ("t", "gx", "gy", "gz"),
+            sample_rate_hz: float | None = None, angles: AngleOutput = "ypr",
+            q0: ArrayLike | None = None, on_gap: RunGapPolicy = "report",
+            gap_tolerance: float = 1.5, saturation: float | None = None,
+            progress: bool = False) -> dict[str, Any]:
     """Process a log; returns a summary (samples, outputs, gaps, saturated rows, warnings).
 
     Parameters
@@ -111,14 +136,14 @@ def run_log(imu, out, *, kind: str, units: str | None, algorithm: str = "rotvec"
     progress : bool
         Show a progress bar (tqdm, on stderr).
     """
-    imu, out = Path(imu), Path(out)
-    if out.resolve() == imu.resolve():
+    imu_path, out_path = Path(imu), Path(out)
+    if out_path.resolve() == imu_path.resolve():
         raise ValueError("--out must not be the input file")
-    if out.suffix.lower() not in (".csv", ".npz"):
-        raise ValueError(f"{out}: output must be .csv or .npz")
-    if angles not in ("ypr", "cone", "none"):
+    if out_path.suffix.lower() not in (".csv", ".npz"):
+        raise ValueError(f"{out_path}: output must be .csv or .npz")
+    if angles not in ANGLES:
         raise ValueError(f"angles must be ypr, cone or none, got {angles!r}")
-    if on_gap not in ("report", "error", "split"):
+    if on_gap not in RUN_GAP_POLICIES:
         raise ValueError(f"on_gap must be report, error or split, got {on_gap!r}")
     spec = AlgorithmSpec(algorithm, subsamples=subsamples, coefficients=coefficients,
                          structure=structure)
@@ -133,25 +158,33 @@ def run_log(imu, out, *, kind: str, units: str | None, algorithm: str = "rotvec"
     read = {"kind": kind, "units": units, "columns": columns, "sample_rate_hz": sample_rate_hz,
             "gap_tolerance": gap_tolerance, "on_gap": "error" if on_gap == "error" else "report",
             "saturation": saturation}
+    fam = spec.family
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         if spec.input_kind == "rate":
-            res = _run_rates(imu, out, read, spec, angles, q0, on_gap == "split")
+            res = _run_rates(imu_path, out_path, read, spec, angles, q0, on_gap == "split")
+        elif isinstance(fam, Rotvec):  # the one increment family that runs on a log
+            res = _run_increments(imu_path, out_path, read, increment_structure(structure),
+                                  fam.coefficient_set(spec), angles, q0, on_gap == "split",
+                                  progress)
         else:
-            res = _run_increments(imu, out, read, structure, spec.family.coefficient_set(spec),
-                                  angles, q0, on_gap == "split", progress)
+            raise ValueError(f"{algorithm} does not run on a log; use rotvec or "
+                             f"{', '.join(algorithms_taking('rate'))}")
     res["warnings"] = [str(w.message) for w in caught]
     return res
 
 
-def _run_increments(imu, out, read, structure, cs, angles, q0, split, progress):
+def _run_increments(imu: Path, out: Path, read: dict[str, Any], structure: IncrementStructure,
+                    cs: CoefficientSet, angles: AngleOutput, q0: ArrayLike | None, split: bool,
+                    progress: bool) -> dict[str, Any]:
     if imu.suffix.lower() == ".npy" and not split:
         if read["units"] is None:
             raise ValueError(f"{imu}: .npy logs carry no units; pass --units")
         total = np.load(imu, mmap_mode="r").shape[0]
-        gaps: list = []
-        saturated: list = []
-        segments = [_npy_chunks(imu, read["units"], read, gaps, saturated)]
+        gaps: list[int] = []
+        saturated: list[int] = []
+        segments: list[Iterator[tuple[NDArray[np.float64], NDArray[np.float64]]]] = [
+            _npy_chunks(imu, read["units"], read, gaps, saturated)]
         h_log = 1.0
     else:
         log = read_imu(imu, **read)
@@ -192,12 +225,15 @@ def _run_increments(imu, out, read, structure, cs, angles, q0, split, progress):
             raise ValueError(f"{imu}: no samples")
         if not csv_out:
             table = np.concatenate(parts) if parts else np.empty((0, len(names)))
+            # Any: np.savez's column keywords share its signature with allow_pickle: bool
+            columns: dict[str, Any] = {k: table[:, i] for i, k in enumerate(names)}
             with open(tmp, "wb") as f:
-                np.savez(f, **{k: table[:, i] for i, k in enumerate(names)})
+                np.savez(f, **columns)
     return {"samples": n_in, "outputs": n_out, "gaps": gaps, "saturated": saturated}
 
 
-def _run_rates(imu, out, read, spec, angles, q0, split):
+def _run_rates(imu: Path, out: Path, read: dict[str, Any], spec: AlgorithmSpec,
+               angles: AngleOutput, q0: ArrayLike | None, split: bool) -> dict[str, Any]:
     from strapdown.io import write_attitude
 
     log = read_imu(imu, **read)
