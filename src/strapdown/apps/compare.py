@@ -19,13 +19,18 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import NDArray
 
+from strapdown._core.kinds import InputKind
 from strapdown.algorithms.spec import AlgorithmSpec, parse_spec
 from strapdown.analysis.evaluate import EvaluationConfig, evaluate
+from strapdown.io.readers import GyroUnit
 from strapdown.io.report import Report
 
 __all__ = ["AlgorithmRun", "compare_log", "compare_motion"]
@@ -35,9 +40,9 @@ class AlgorithmRun:
     """One algorithm's error history and summary (rad, s)."""
 
     label: str
-    t: np.ndarray
-    angle: np.ndarray
-    summary: dict
+    t: NDArray[np.float64]
+    angle: NDArray[np.float64]
+    summary: dict[str, object]
 
 
 def _summary_row(label, t, angle, update_period, extra=None) -> dict:
@@ -49,7 +54,8 @@ def _summary_row(label, t, angle, update_period, extra=None) -> dict:
     return row
 
 
-def compare_motion(base: EvaluationConfig, specs, out, *, progress=None) -> list[AlgorithmRun]:
+def compare_motion(base: EvaluationConfig, specs: Iterable[str], out: str | os.PathLike[str], *,
+                   progress: Callable[[str], None] | None = None) -> list[AlgorithmRun]:
     """Run every spec on ``base``'s motion and sensor; write the figure and tables to ``out``."""
     specs = list(specs)
     if not specs:
@@ -72,7 +78,8 @@ def compare_motion(base: EvaluationConfig, specs, out, *, progress=None) -> list
     return runs
 
 
-def _read_truth(path) -> tuple[np.ndarray, np.ndarray]:
+def _read_truth(path: str | os.PathLike[str]
+                ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     path = Path(path)
     if path.suffix.lower() == ".npz":
         with np.load(path) as z:
@@ -92,7 +99,9 @@ def _read_truth(path) -> tuple[np.ndarray, np.ndarray]:
     return arr[:, cols[0]], arr[:, cols[1:]]
 
 
-def _errors_against(t_ref, q_ref, t, q) -> tuple[np.ndarray, np.ndarray]:
+def _errors_against(t_ref: NDArray[np.float64], q_ref: NDArray[np.float64],
+                    t: NDArray[np.float64], q: NDArray[np.float64]
+                    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Angle between ``q`` and the reference slerped to ``t`` (inside the reference span)."""
     from scipy.spatial.transform import Slerp
 
@@ -115,9 +124,11 @@ def _run_on_log(log, fields, q0):
     return spec.run(log, q0=q0), spec.update_period(log.h)
 
 
-def compare_log(imu, specs, out, *, kind: str, units: str | None,
-                columns=("t", "gx", "gy", "gz"), sample_rate_hz=None, truth=None,
-                progress=None) -> list[AlgorithmRun]:
+def compare_log(imu: str | os.PathLike[str], specs: Iterable[str], out: str | os.PathLike[str],
+                *, kind: InputKind, units: GyroUnit | None,
+                columns: Sequence[str] = ("t", "gx", "gy", "gz"),
+                sample_rate_hz: float | None = None, truth: str | os.PathLike[str] | None = None,
+                progress: Callable[[str], None] | None = None) -> list[AlgorithmRun]:
     """Run every spec on one gyro log and compare them (see the module docstring)."""
     from strapdown.io import read_imu
 
