@@ -47,28 +47,31 @@ import hashlib
 import itertools
 import json
 import math
+import os
 import sys
 import tomllib
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Literal, get_args
 
 import numpy as np
 
 from strapdown.algorithms.spec import parse_spec
-from strapdown.analysis.evaluate import EvaluationConfig, evaluate
+from strapdown.analysis.evaluate import METRICS, EvaluationConfig, MetricName, evaluate
 from strapdown.io.files import atomic_path, csv_table, write_text
 from strapdown.truth.sensors import GyroErrors
 
-__all__ = ["Case", "Scenario", "SweepInterrupted", "SweepResult", "cases", "load_scenario",
-           "run_case", "sweep"]
+__all__ = ["FORMATS", "Case", "Scenario", "SweepInterrupted", "SweepResult", "TableFormat",
+           "cases", "load_scenario", "run_case", "sweep"]
 
-#: Metric names a scenario may ask for (keys of Evaluation.to_dict).
-METRICS = ("max_error_rad", "rms_error_rad", "cone_axis_drift_rad_s", "predicted_drift_rad_s",
-           "drift_rate_rad_s", "accumulated_drift_rad", "update_period_s", "samples",
-           "chain_cone_axis_drift_rad_s", "drift_points")
-DEFAULT_METRICS = ("max_error_rad", "rms_error_rad", "cone_axis_drift_rad_s",
-                   "predicted_drift_rad_s")
+# The metric names a scenario may ask for are the evaluation's (METRICS, MetricName: keys of
+# Evaluation.to_dict), defined in strapdown.analysis.evaluate.
+DEFAULT_METRICS: tuple[MetricName, ...] = ("max_error_rad", "rms_error_rad",
+                                           "cone_axis_drift_rad_s", "predicted_drift_rad_s")
+#: The table formats a finished sweep writes.
+TableFormat = Literal["csv", "parquet"]
+FORMATS: tuple[TableFormat, ...] = get_args(TableFormat)
 _CONFIG_FIELDS = {f.name for f in dataclasses.fields(EvaluationConfig)} - {"gyro", "seed"}
 _GYRO_FIELDS = {f.name for f in dataclasses.fields(GyroErrors)}
 _SECTIONS = ("motion", "sensor", "run")
@@ -261,7 +264,7 @@ class SweepInterrupted(KeyboardInterrupt):
         self.total = total
 
 
-def _parse_scheduler(scheduler: str):
+def _parse_scheduler(scheduler: str) -> tuple[Literal["local", "dask"], str | None]:
     if scheduler == "local":
         return "local", None
     if scheduler.startswith("dask://"):
@@ -272,8 +275,9 @@ def _parse_scheduler(scheduler: str):
     raise ValueError(f"--scheduler must be 'local' or 'dask://HOST:PORT', got {scheduler!r}")
 
 
-def sweep(scenario, out, *, scheduler: str = "local", workers: int | None = None,
-          formats=("csv", "parquet"), max_cases: int | None = None,
+def sweep(scenario: str | os.PathLike[str] | Scenario, out: str | os.PathLike[str], *,
+          scheduler: str = "local", workers: int | None = None,
+          formats: Iterable[TableFormat] = FORMATS, max_cases: int | None = None,
           progress: bool = False, log: Callable[[str], None] | None = None) -> SweepResult:
     """Run (or finish) a scenario's grid; see the module docstring.
 
@@ -282,7 +286,9 @@ def sweep(scenario, out, *, scheduler: str = "local", workers: int | None = None
     scenario : path or Scenario
     out : path
         Output directory (created). Finished cases live in ``out/cases``.
-    scheduler : {"local", "dask://HOST:PORT"}
+    scheduler : str
+        ``"local"`` (a process pool) or ``"dask://HOST:PORT"`` (a Dask cluster); a string,
+        not a Literal, because of the address.
     workers : int, optional
         Local pool size (default: CPU count); 1 runs in this process.
     formats : subset of {"csv", "parquet"}
@@ -303,7 +309,7 @@ def sweep(scenario, out, *, scheduler: str = "local", workers: int | None = None
     """
     kind, address = _parse_scheduler(scheduler)
     formats = tuple(formats)
-    bad = [f for f in formats if f not in ("csv", "parquet")]
+    bad = [f for f in formats if f not in FORMATS]
     if bad or not formats:
         raise ValueError(f"formats must be a non-empty subset of csv, parquet; got {formats}")
     if "parquet" in formats:
