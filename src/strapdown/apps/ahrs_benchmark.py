@@ -23,27 +23,34 @@ inclination RMSE over movement phases, in degrees. Writes ``errors.csv``,
 from __future__ import annotations
 
 import math
+import os
 import time
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any, Literal, get_args
 
 import numpy as np
+from numpy.typing import NDArray
 
 from strapdown.ahrs import AhrsConfig, ekf
 from strapdown.analysis.broad import broad_errors
 from strapdown.io.broad import BroadTrial, read_broad
 from strapdown.io.report import Report
 
-__all__ = ["FILTERS", "benchmark", "run_filter"]
+__all__ = ["FILTERS", "FilterName", "benchmark", "run_filter"]
 
-FILTERS = ("strapdown EKF", "strapdown EKF, no gating", "strapdown EKF, raw acc",
-           "strapdown EKF, raw acc, no gating", "VQF", "Fusion")
-_OURS = {"strapdown EKF": {}, "strapdown EKF, no gating": {"gating": False},
-         "strapdown EKF, raw acc": {"acc_model": "raw"},
-         "strapdown EKF, raw acc, no gating": {"acc_model": "raw", "gating": False}}
+#: The filters compared (see the module docstring).
+FilterName = Literal["strapdown EKF", "strapdown EKF, no gating", "strapdown EKF, raw acc",
+                     "strapdown EKF, raw acc, no gating", "VQF", "Fusion"]
+FILTERS: tuple[FilterName, ...] = get_args(FilterName)
+#: AhrsConfig fields of our filter's variants.
+_OURS: dict[FilterName, dict[str, Any]] = {
+    "strapdown EKF": {}, "strapdown EKF, no gating": {"gating": False},
+    "strapdown EKF, raw acc": {"acc_model": "raw"},
+    "strapdown EKF, raw acc, no gating": {"acc_model": "raw", "gating": False}}
 
 
-def _vqf(tr: BroadTrial) -> np.ndarray:
+def _vqf(tr: BroadTrial) -> NDArray[np.float64]:
     import vqf
 
     out = vqf.offlineVQF(np.ascontiguousarray(tr.gyro), np.ascontiguousarray(tr.acc),
@@ -51,7 +58,7 @@ def _vqf(tr: BroadTrial) -> np.ndarray:
     return np.asarray(out["quat9D"])
 
 
-def _fusion(tr: BroadTrial) -> np.ndarray:
+def _fusion(tr: BroadTrial) -> NDArray[np.float64]:
     import imufusion
 
     fs = 1.0 / tr.h
@@ -79,7 +86,8 @@ def _fusion(tr: BroadTrial) -> np.ndarray:
     return q
 
 
-def run_filter(name: str, tr: BroadTrial, *, algorithm: str = "rate-single"):
+def run_filter(name: FilterName, tr: BroadTrial, *, algorithm: str = "rate-single"
+               ) -> tuple[NDArray[np.float64], NDArray[np.int_]]:
     """``(q at every sample index it outputs, indices)`` for one filter on one trial."""
     if name in _OURS:
         r = ekf(tr.t, tr.gyro, tr.acc, tr.mag, algorithm=algorithm,
@@ -105,7 +113,8 @@ def _available(name: str) -> str | None:
     return None
 
 
-def benchmark(directory, out, *, algorithm: str = "rate-single",
+def benchmark(directory: str | os.PathLike[str], out: str | os.PathLike[str], *,
+              algorithm: str = "rate-single",
               progress: Callable[[str], None] | None = None) -> dict:
     """Run every filter on every trial; returns ``{(trial, filter): errors}`` and writes the
     report to ``out``."""

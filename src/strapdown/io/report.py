@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -11,7 +12,7 @@ from typing import Any
 from strapdown.io.files import csv_table, markdown_table, save_figure, write_text
 
 
-def prepare_out(out: str | Path) -> Path:
+def prepare_out(out: str | os.PathLike[str]) -> Path:
     """Create the output directory; refuse a path that is an existing file."""
     out = Path(out)
     if out.exists() and not out.is_dir():
@@ -77,7 +78,8 @@ class Report:
     parts: list[str] = field(default_factory=list)
 
     @classmethod
-    def begin(cls, out: str | Path, progress: Callable[[str], None] | None = None) -> Report:
+    def begin(cls, out: str | os.PathLike[str],
+              progress: Callable[[str], None] | None = None) -> Report:
         """Start a report: headless matplotlib, the output directory, its writer."""
         import matplotlib
 
