@@ -1,0 +1,324 @@
+"""Velocity and position updates with rotation, sculling and scrolling compensation.
+
+Over an update of N gyro increments ``θ_j`` and accelerometer increments ``v_j`` (rad,
+m/s; ``α = Σθ_j``, ``υ = Σv_j``) the body-frame quantities at the update start are
+(Savage (1998b), the velocity and position algorithms; Ignagni (1998), the duality):
+
+rotation vector (coning)
+    ``φ = α + Σ_{i<j} k_ij θ_i × θ_j`` — Li & Zhang (2017) eq. 6, Table 3.
+velocity increment (rotation + sculling compensation)
+    ``Δv_b = υ + ½ α × υ + ⅙ α × (α × υ) + Σ_{i<j} s_ij (θ_i × v_j + v_i × θ_j)``;
+    ``½ α × υ + ⅙ α × (α × υ)`` is the rotation compensation of a constant rate to second
+    order, the pair sum the sculling compensation ``½∫(α × f + υ × ω) dt``. The sculling
+    coefficients ``s`` come from the designer's sculling target
+    (:data:`strapdown.algorithms.tables.SCULLING_CONVENTIONAL`), which reproduces the
+    coning set of the same structure.
+position increment (scrolling compensation)
+    ``ΔR_b = h (Σ_{j=1}^{N−1} ΔV_j + ½ Δv_b)``: the trapezoid rule over the
+    subsample-resolved velocity increment ``ΔV_j`` (rotation compensation on the partial
+    sums plus Savage's recursive two-sample sculling ``(1/12)(θ_{j−1} × v_j + v_{j−1} ×
+    θ_j)``), closed by the N-sample ``Δv_b``. Exact for constant specific force and rate to
+    second order; its error for a time-varying force telescopes in the navigation frame.
+
+The single chain (``single-chain``) updates every sample with the designer's single-chain
+coefficients for both corrections, ``Δv_k = v_k + ½ θ_k × v_k + ⅙ θ_k × (θ_k × v_k) +
+Σ_m c_m (θ_{k−m} × v_k + v_{k−m} × θ_k)`` and ``ΔR_k = ½ h Δv_k`` (start-up: sample
+k < N − 1 uses the (k+1)-sample set).
+
+Classical-sculling law (derived by :func:`strapdown.design.derive` with
+``target="sculling"``): the rectified velocity error rate along the axis normal to both
+vibrations is ``−c · θ0 A cos ψ (Ωh)^{2N}``, ``c = N!(N+1)!/(2N+2)!``, for both
+structures (:func:`sculling_law`).
+
+:func:`integrate_inertial` chains the increments in a non-rotating frame without gravity
+(the sculling studies); :mod:`strapdown.algorithms.navigation` on the WGS-84 Earth.
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass
+from fractions import Fraction
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from strapdown._core.validation import as_quaternions, as_vectors, finite_array, positive
+from strapdown._core.validation import positive_int as _positive_int
+from strapdown.algorithms import _nav_kernels, tables
+from strapdown.algorithms.coning import MAX_SUBSAMPLES, coefficient_set
+from strapdown.algorithms.structures import single_chain_table
+
+__all__ = [
+    "NAV_STRUCTURES",
+    "BodyIncrements",
+    "InertialSolution",
+    "ScullingLaw",
+    "body_increments",
+    "integrate_inertial",
+    "integrate_inertial_mp",
+    "sculling_law",
+    "sculling_matrix",
+    "sculling_single_chain_table",
+]
+
+#: Update structures of the velocity/position algorithms.
+NAV_STRUCTURES = ("conventional", "single-chain")
+
+
+@dataclass(frozen=True)
+class ScullingLaw:
+    """Rectified classical-sculling velocity error rate ``−c · θ0 A cos ψ (Ωh)^order``."""
+
+    order: int
+    constant: Fraction
+
+    def predict(self, angle_amplitude: float, accel_amplitude: float, phase: float,
+                frequency: float, h: float) -> float:
+        """The law's rate (m/s²) along the axis normal to both vibrations."""
+        return (-float(self.constant) * angle_amplitude * accel_amplitude * np.cos(phase)
+                * (frequency * h) ** self.order)
+
+
+def _n(n: int) -> int:
+    n = _positive_int(n, "N (subsamples)")
+    if n > MAX_SUBSAMPLES:
+        raise ValueError(f"N (subsamples) must be at most {MAX_SUBSAMPLES}, got {n}")
+    return n
+
+
+def _structure(structure: str) -> str:
+    if structure not in NAV_STRUCTURES:
+        raise ValueError(f"unknown velocity structure {structure!r}; choose one of "
+                         f"{', '.join(NAV_STRUCTURES)}")
+    return structure
+
+
+def sculling_law(n: int) -> ScullingLaw:
+    """The classical-sculling law of the N-sample sets (:data:`tables.SCULLING_DRIFT`)."""
+    order, c = tables.SCULLING_DRIFT[_n(n)]
+    return ScullingLaw(order, c)
+
+
+def sculling_matrix(n: int, *, exact: bool = False):
+    """``(N, N)`` upper-triangular sculling matrix of the conventional structure:
+    ``s[N−1−m, N−1] = ς_m`` (cross with the last subsample). ``exact=True``: nested lists
+    of :class:`~fractions.Fraction`."""
+    n = _n(n)
+    rows = [[Fraction(0)] * n for _ in range(n)]
+    for m, c in enumerate(tables.SCULLING_CONVENTIONAL[n], start=1):
+        rows[n - 1 - m][n - 1] = c
+    if exact:
+        return rows
+    return np.array([[float(v) for v in r] for r in rows])
+
+
+def sculling_single_chain_table(n: int, *, exact: bool = False):
+    """Start-up and steady single-chain sculling coefficients, shape (N, N − 1), laid out as
+    :func:`strapdown.algorithms.structures.single_chain_table`."""
+    n = _n(n)
+    rows = [[Fraction(0)] * max(n - 1, 1) for _ in range(n)]
+    for m in range(1, n):
+        rows[m][:m] = tables.SCULLING_SINGLE_CHAIN[m + 1]
+    if exact:
+        return rows
+    return np.array([[float(v) for v in r] for r in rows])
+
+
+@dataclass(frozen=True)
+class BodyIncrements:
+    """Per-update body-frame increments (at each update's start attitude).
+
+    Attributes
+    ----------
+    phi, dv, dr : ndarray of shape (m, 3)
+        Rotation vector (rad), compensated velocity increment (m/s) and position increment
+        (m).
+    h, update_period : float
+        Sample interval and time between updates (s).
+    structure : str
+    n : int
+    """
+
+    phi: NDArray[np.float64]
+    dv: NDArray[np.float64]
+    dr: NDArray[np.float64]
+    h: float
+    update_period: float
+    structure: str
+    n: int
+
+
+def _inputs(gyro: ArrayLike, accel: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    g = as_vectors(gyro, "gyro increments")
+    a = as_vectors(accel, "accelerometer increments")
+    if g.ndim != 2 or a.shape != g.shape:
+        raise ValueError(f"gyro and accelerometer increments must both have shape (n, 3); got "
+                         f"{g.shape} and {a.shape}")
+    return np.ascontiguousarray(g), np.ascontiguousarray(a)
+
+
+def body_increments(gyro: ArrayLike, accel: ArrayLike, n: int, *, h: float,
+                    structure: str = "conventional", sculling: bool = True) -> BodyIncrements:
+    """Coning, sculling and scrolling compensated body increments (module docstring).
+
+    Parameters
+    ----------
+    gyro, accel : array_like of shape (k, 3)
+        Gyro (rad) and accelerometer (m/s) increments over consecutive intervals ``h``.
+    n : int
+        N, samples per update (conventional) or the single chain's N.
+    h : float
+        Sample interval (s).
+    structure : {"conventional", "single-chain"}
+    sculling : bool
+        False drops the sculling pair terms (rotation compensation only), to show their
+        effect; the coning correction stays.
+
+    The conventional structure drops a tail of fewer than N samples.
+    """
+    g, a = _inputs(gyro, accel)
+    n, h = _n(n), positive(h, "h (sample interval)")
+    if _structure(structure) == "conventional":
+        m = g.shape[0] // n
+        if m < 1:
+            raise ValueError(f"N = {n} needs at least {n} samples, got {g.shape[0]}")
+        kc = np.ascontiguousarray(coefficient_set("table3", n).matrix)
+        ks = sculling_matrix(n) if sculling else np.zeros((n, n))
+        out = np.empty((3, m, 3))
+        _nav_kernels.conventional_body_kernel(g[: m * n], a[: m * n], kc, ks, h, out[0],
+                                              out[1], out[2])
+        return BodyIncrements(out[0], out[1], out[2], h, n * h, structure, n)
+    if g.shape[0] < 1:
+        raise ValueError("the single chain needs at least one sample")
+    tab_s = sculling_single_chain_table(n)
+    out = np.empty((3, g.shape[0], 3))
+    _nav_kernels.single_chain_body_kernel(g, a, single_chain_table(n),
+                                          tab_s if sculling else np.zeros_like(tab_s), h,
+                                          out[0], out[1], out[2])
+    return BodyIncrements(out[0], out[1], out[2], h, h, structure, n)
+
+
+@dataclass(frozen=True)
+class InertialSolution:
+    """Attitude, velocity and position in a non-rotating frame without gravity.
+
+    ``t`` (m,), ``q`` (m, 4) ``q_n_b``, ``v`` (m, 3) m/s, ``p`` (m, 3) m; ``startup`` the
+    first steady-state output (N − 1 for the single chain, else 0).
+    """
+
+    t: NDArray[np.float64]
+    q: NDArray[np.float64]
+    v: NDArray[np.float64]
+    p: NDArray[np.float64]
+    structure: str
+    n: int
+    h: float
+    update_period: float
+    startup: int = 0
+
+
+def _state(q0, v0, p0):
+    q = np.array([1.0, 0.0, 0.0, 0.0]) if q0 is None else as_quaternions(q0, "q0")
+    if q.shape != (4,):
+        raise ValueError(f"q0 must have shape (4,), got {q.shape}")
+    v = np.zeros(3) if v0 is None else as_vectors(v0, "v0")
+    p = np.zeros(3) if p0 is None else as_vectors(p0, "p0")
+    if v.shape != (3,) or p.shape != (3,):
+        raise ValueError(f"v0 and p0 must have shape (3,), got {v.shape} and {p.shape}")
+    return q / np.linalg.norm(q), v, p
+
+
+def integrate_inertial(gyro: ArrayLike, accel: ArrayLike, n: int, *, h: float,
+                       structure: str = "conventional", t0: float = 0.0,
+                       q0: ArrayLike | None = None, v0: ArrayLike | None = None,
+                       p0: ArrayLike | None = None, sculling: bool = True) -> InertialSolution:
+    """Strapdown integration in a non-rotating frame without gravity (sculling studies).
+
+    ``v_m = v_{m−1} + C_{m−1} Δv_b``, ``p_m = p_{m−1} + v_{m−1} T + C_{m−1} ΔR_b``,
+    ``q_m = q_{m−1} ⊗ q(φ_m)`` with the increments of :func:`body_increments`.
+    """
+    q0, v0, p0 = _state(q0, v0, p0)
+    t0 = float(finite_array(t0, "t0"))
+    b = body_increments(gyro, accel, n, h=h, structure=structure, sculling=sculling)
+    m = b.phi.shape[0]
+    q = np.empty((m + 1, 4))
+    v = np.empty((m + 1, 3))
+    p = np.empty((m + 1, 3))
+    _nav_kernels.inertial_kernel(b.phi, b.dv, b.dr, b.update_period, q0, v0, p0, q, v, p)
+    t = t0 + np.arange(m + 1) * b.update_period
+    startup = min(b.n - 1, m) if structure == "single-chain" else 0
+    return InertialSolution(t, q, v, p, structure, b.n, b.h, b.update_period, startup)
+
+
+@dataclass(frozen=True)
+class MpInertialSolution:
+    """Errors of an arbitrary-precision run, formed in high precision, as float64.
+
+    ``t`` (m,) output times; ``dv``, ``dp`` (m, 3) velocity and position errors
+    (computed − true) in the navigation frame.
+    """
+
+    t: NDArray[np.float64]
+    dv: NDArray[np.float64]
+    dp: NDArray[np.float64]
+    digits: int
+    startup: int = 0
+
+
+def integrate_inertial_mp(motion, n: int, *, h: float, samples: int, digits: int,
+                          structure: str = "conventional") -> MpInertialSolution:
+    """:func:`integrate_inertial` in arbitrary precision on a closed-form sculling motion.
+
+    Exact increments (:meth:`~strapdown.truth.sculling.ScullingMotion.increment_mp`,
+    :meth:`~strapdown.truth.sculling.ScullingMotion.velocity_increment_mp`), exact
+    rational coefficients and the plain-Python twin of the kernels
+    (:mod:`strapdown.algorithms._nav_reference`) at ``digits`` significant digits; the
+    errors against the exact velocity and position are converted to float64 at the end.
+    """
+    import mpmath
+
+    from strapdown._core.backend import MPMATH
+    from strapdown.algorithms import _nav_reference as ref
+    from strapdown.algorithms.precision import MAX_MP_SAMPLES
+
+    n, h = _n(n), positive(h, "h (sample interval)")
+    samples, digits = _positive_int(samples, "samples"), _positive_int(digits, "digits")
+    if samples > MAX_MP_SAMPLES:
+        raise ValueError(f"{samples} samples exceed the arbitrary-precision limit of "
+                         f"{MAX_MP_SAMPLES}")
+    if digits < 17:
+        raise ValueError(f"digits must be at least 17 (float64 is ~16), got {digits}")
+    _structure(structure)
+    with mpmath.workdps(digits):
+        hm = mpmath.mpf(h)
+        edges = [k * hm for k in range(samples + 1)]
+        g = [motion.increment_mp(a, b) for a, b in itertools.pairwise(edges)]
+        a = [motion.velocity_increment_mp(a, b) for a, b in itertools.pairwise(edges)]
+        zero = mpmath.mpf(0)
+
+        def mp(rows):
+            return [[mpmath.mpf(v.numerator) / v.denominator for v in r] for r in rows]
+
+        if structure == "conventional":
+            kc = mp(coefficient_set("table3", n).exact)
+            body = ref.conventional_body(g, a, kc, mp(sculling_matrix(n, exact=True)), hm, zero)
+            period, startup = n * hm, 0
+        else:
+            from strapdown.algorithms.structures import single_chain_coefficients
+
+            tab_c = [[Fraction(0)] * max(n - 1, 1) for _ in range(n)]
+            for m_ in range(1, n):
+                tab_c[m_][:m_] = single_chain_coefficients(m_ + 1)
+            body = ref.single_chain_body(g, a, mp(tab_c), mp(sculling_single_chain_table(
+                n, exact=True)), hm)
+            period, startup = hm, n - 1
+        _qs, vs, ps = ref.inertial(body, period, motion.attitude_mp(zero), (zero,) * 3,
+                                  (zero,) * 3, MPMATH)
+        t = [k * period for k in range(len(vs))]
+        dv = np.array([[float(c - e) for c, e in zip(v, motion.velocity_mp(tt), strict=True)]
+                       for v, tt in zip(vs, t, strict=True)])
+        dp = np.array([[float(c - e) for c, e in zip(p, motion.position_mp(tt), strict=True)]
+                       for p, tt in zip(ps, t, strict=True)])
+    return MpInertialSolution(np.array([float(x) for x in t]), dv, dp, digits,
+                              min(startup, len(t) - 1))
