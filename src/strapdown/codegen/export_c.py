@@ -14,18 +14,25 @@ matches the Python library to round-off.
 from __future__ import annotations
 
 import re
+from collections.abc import Callable
 from dataclasses import dataclass
 from fractions import Fraction
 from pathlib import Path
+from typing import Any, Literal, get_args
 
 from strapdown._core.series import SMALL_ANGLE
 from strapdown._core.validation import positive
 from strapdown.algorithms.coning import coefficient_set
+from strapdown.algorithms.family import AlgorithmName, StructureName
 from strapdown.algorithms.spec import ALGORITHMS as REGISTERED
-from strapdown.algorithms.spec import AlgorithmSpec
+from strapdown.algorithms.spec import AlgorithmSpec, CoefficientName
 from strapdown.io.files import write_text
 
-__all__ = ["ALGORITHMS", "CExport", "export_c", "generate"]
+__all__ = ["ALGORITHMS", "REALS", "CExport", "CReal", "export_c", "generate"]
+
+#: The C floating-point type of the generated code (``--float``).
+CReal = Literal["double", "float"]
+REALS: tuple[CReal, ...] = get_args(CReal)
 
 @dataclass(frozen=True)
 class CExport:
@@ -34,8 +41,8 @@ class CExport:
     name: str
     header: str
     source: str
-    ops: dict
-    real: str
+    ops: dict[str, int]
+    real: CReal
 
 
 def _lit(x, real) -> str:
@@ -148,15 +155,15 @@ def _phi_rotvec(terms, src, base_expr, n, real, comment=True):
     return "\n".join(lines)
 
 
-def generate(algorithm: str, *, structure: str = "conventional", subsamples: int = 3,
-             coefficients: str | None = None, real: str = "double", h: float = 1e-4,
-             name: str | None = None) -> CExport:
+def generate(algorithm: AlgorithmName, *, structure: StructureName = "conventional",
+             subsamples: int = 3, coefficients: CoefficientName | None = None,
+             real: CReal = "double", h: float = 1e-4, name: str | None = None) -> CExport:
     """Generate the C for one configuration (see :func:`export_c`)."""
     if algorithm not in _GENERATORS:
         raise ValueError(f"unknown algorithm {algorithm!r}; choose one of {', '.join(ALGORITHMS)}")
     spec = AlgorithmSpec(algorithm, structure=structure, subsamples=subsamples,
                          coefficients=coefficients)
-    if real not in ("double", "float"):
+    if real not in REALS:
         raise ValueError(f"--float must be double or float, got {real!r}")
     h = positive(h, "h (sample interval)")
     name = name or re.sub(r"[^a-z0-9]+", "_", f"sd_{algorithm}_{structure}"
@@ -451,13 +458,14 @@ int NAME_update(NAME_state *s, const real_t sample[3], real_t q_out[4])
 
 
 #: C generator per exportable family (the C templates are the exporter's own knowledge).
-_GENERATORS = {"rotvec": _gen_rotvec, "rate-single": _gen_rate, "rate-three": _gen_rate,
-               "rk4": _gen_rk4}
+_GENERATORS: dict[AlgorithmName, Callable[[AlgorithmSpec, CReal, float],
+                                           tuple[str, str, dict[str, int], str]]] = {
+    "rotvec": _gen_rotvec, "rate-single": _gen_rate, "rate-three": _gen_rate, "rk4": _gen_rk4}
 #: Families ``export-c`` can generate, in registry order.
-ALGORITHMS = tuple(a for a in REGISTERED if a in _GENERATORS)
+ALGORITHMS: tuple[AlgorithmName, ...] = tuple(a for a in REGISTERED if a in _GENERATORS)
 
 
-def export_c(out: str | Path, **kwargs) -> CExport:
+def export_c(out: str | Path, **kwargs: Any) -> CExport:
     """Generate and write ``<name>.h`` and ``<name>.c`` into ``out`` (atomically)."""
     exp = generate(**kwargs)
     out = Path(out)
