@@ -13,8 +13,12 @@ from __future__ import annotations
 import importlib
 from dataclasses import dataclass
 from types import ModuleType
+from typing import Literal, get_args
 
-__all__ = ["REPRODUCTIONS", "Reproduction", "reproduction"]
+__all__ = ["REPRODUCTIONS", "Reproduction", "ReproductionName", "reproduction"]
+
+#: The reproductions' command-line names, in the order the command line lists them.
+ReproductionName = Literal["li2017", "wang-rate", "wang-sliding", "plaksiy2024", "zhang2021"]
 
 
 @dataclass(frozen=True)
@@ -26,7 +30,7 @@ class Reproduction:
 
 
 #: Every reproduction by its command-line name, in the order the command line lists them.
-REPRODUCTIONS: dict[str, Reproduction] = {
+REPRODUCTIONS: dict[ReproductionName, Reproduction] = {
     "li2017": Reproduction("strapdown.reproduce.li2017",
                            "Li & Zhang (2017): coning coefficients and update structures"),
     "wang-rate": Reproduction("strapdown.reproduce.wang_rate",
@@ -39,7 +43,12 @@ REPRODUCTIONS: dict[str, Reproduction] = {
 }
 
 
-def reproduction(name: str) -> ModuleType:
+if tuple(REPRODUCTIONS) != get_args(ReproductionName):  # one list of names: the Literal
+    raise RuntimeError(f"REPRODUCTIONS {tuple(REPRODUCTIONS)} and ReproductionName "
+                       f"{get_args(ReproductionName)} disagree")
+
+
+def reproduction(name: ReproductionName) -> ModuleType:
     """The module of reproduction ``name`` (imported now); an unknown name lists the known."""
     try:
         entry = REPRODUCTIONS[name]

@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from strapdown import analysis
+from strapdown.algorithms.family import QuaternionAlgorithmName
 from strapdown.algorithms.quaternion import (
     ALGORITHMS,
     STATED,
@@ -53,7 +54,7 @@ LONG = 3200.0
 class DriftRun:
     """Increments and truth of one motion/step, reused across coefficient evaluations."""
 
-    def __init__(self, motion: Motion, name: str, step: float = STEP,
+    def __init__(self, motion: Motion, name: QuaternionAlgorithmName, step: float = STEP,
                  duration: float = DURATION):
         sub = subintervals(name)
         n = round(duration / step)
@@ -117,7 +118,7 @@ def reproduce(out: str | Path, *, progress: Callable[[str], None] | None = None)
     return r.write("\n".join(report))
 
 
-def _first(n: str) -> tuple:
+def _first(n: QuaternionAlgorithmName) -> tuple[float, float]:
     """The coefficients that reproduce Table 1: the stated ones, but 9/20, 27/40 for A1."""
     return REPRODUCING_A1 if n == "miller" else STATED[n]
 

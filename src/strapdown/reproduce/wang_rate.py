@@ -26,6 +26,7 @@ import numpy as np
 
 from strapdown import analysis
 from strapdown.algorithms import rate
+from strapdown.algorithms.family import RateAlgorithmName, RateCoefficients, Rk4Step, StructureName
 from strapdown.algorithms.spec import AlgorithmSpec
 from strapdown.analysis.evaluate import EvaluationConfig, evaluate
 from strapdown.io.report import Report
@@ -37,7 +38,8 @@ SPP = (600, 240, 120, 60)
 DIGITS = 80
 
 #: (label, algorithm, structure, coefficients, rk4 step, order the paper's derivation claims)
-ALGS = [
+ALGS: list[tuple[str, RateAlgorithmName, StructureName, RateCoefficients | None, Rk4Step,
+                 int | None]] = [
     ("single-period, paper (c = 1/12)", "rate-single", "conventional", "paper", "2td", 4),
     ("single-period, derived (c = 1/6)", "rate-single", "conventional", "derived", "2td", 4),
     ("three-period, paper", "rate-three", "conventional", "paper", "2td", 8),

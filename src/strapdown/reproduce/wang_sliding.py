@@ -41,7 +41,7 @@ from strapdown.rotation.euler import euler_zyx_from_dcm
 from strapdown.rotation.quaternion import quat_conjugate, quat_multiply, quat_rotate
 from strapdown.truth import sensors
 from strapdown.truth.motions import ClassicalConing
-from strapdown.truth.trajectory import WANG_VARIANTS, EarthField, wang_circle
+from strapdown.truth.trajectory import WANG_VARIANTS, EarthField, WangVariant, wang_circle
 
 #: (label, propagation spec, update period in td) — the paper's algorithms 1–3
 FILTERS = [
@@ -79,7 +79,7 @@ class Simulation:
     mag: np.ndarray
 
 
-def simulate(variant: str, *, rate_hz: float = RATE_HZ, vibration: Vibration | None = None,
+def simulate(variant: WangVariant, *, rate_hz: float = RATE_HZ, vibration: Vibration | None = None,
              seed: int = 1) -> Simulation:
     """Truth and sensor samples for one flight (seeded)."""
     flight = wang_circle(variant)
