@@ -10,6 +10,7 @@ import pytest
 
 import strapdown.ahrs._kernel as K
 from conftest import BROAD
+from strapdown.ahrs import MeasurementFlag as Flag
 from strapdown.ahrs.filter import Q_NED_ENU, AhrsConfig, attitude_from_acc_mag, ekf
 from strapdown.analysis.broad import broad_errors
 from strapdown.rotation.dcm import dcm_from_quat
@@ -84,7 +85,7 @@ def test_bias_is_estimated_at_rest_and_then_in_motion():
     r = ekf(t, w, acc, mag)
     at_10 = np.searchsorted(t[r.index], 9.9)
     assert np.allclose(r.gyro_bias[at_10], bias, atol=2e-4)  # zero-rate updates at rest
-    assert r.fraction(K.F_REST) > 0.1
+    assert r.fraction(Flag.REST) > 0.1
     err = attitude_error_angle(r.q, q[r.index])
     assert err[t[r.index] > 1].max() < math.radians(0.5)
 
@@ -104,10 +105,10 @@ def test_magnetic_anomaly_is_rejected_and_heading_recovers():
     during = (t[gated.index] > 20) & (t[gated.index] < 40)
     e_g = attitude_error_angle(gated.q, q[gated.index])
     e_o = attitude_error_angle(open_.q, q[open_.index])
-    assert np.mean((gated.flags[during] & K.F_MAG_USED) > 0) < 0.05  # rejected
+    assert np.mean((gated.flags[during] & Flag.MAG_USED) > 0) < 0.05  # rejected
     assert e_g[during].max() < 0.2 * e_o[during].max()
     after = t[gated.index] > 45
-    assert np.mean((gated.flags[after] & K.F_MAG_USED) > 0) > 0.95  # used again
+    assert np.mean((gated.flags[after] & Flag.MAG_USED) > 0) > 0.95  # used again
     assert e_g[after].max() < math.radians(1.0)
 
 
@@ -117,7 +118,7 @@ def test_no_magnetometer_degraded_mode():
     q, w, acc, _ = _imu(_motion(), t)
     r = ekf(t, w, acc, None, q0=q[0])
     assert not r.heading_observed
-    assert not np.any(r.flags & K.F_MAG_USED)
+    assert not np.any(r.flags & Flag.MAG_USED)
     # tilt still comes from the accelerometer: the attitude stays within the gyro's accuracy
     assert attitude_error_angle(r.q, q[r.index]).max() < 1e-3
 

@@ -1,7 +1,9 @@
 """The AHRS: a multiplicative error-state EKF propagated by any of the library's attitude
-algorithms (:mod:`strapdown.ahrs.filter`), compiled as one loop (:mod:`strapdown.ahrs._kernel`).
+algorithms (:mod:`strapdown.ahrs.filter`), compiled as one loop (:mod:`strapdown.ahrs._kernel`);
+:class:`MeasurementFlag` says what each output did with its measurements.
 """
 
 from strapdown.ahrs.filter import AhrsConfig, AhrsResult, attitude_from_acc_mag, ekf
+from strapdown.ahrs.flags import MeasurementFlag
 
-__all__ = ["AhrsConfig", "AhrsResult", "attitude_from_acc_mag", "ekf"]
+__all__ = ["AhrsConfig", "AhrsResult", "MeasurementFlag", "attitude_from_acc_mag", "ekf"]

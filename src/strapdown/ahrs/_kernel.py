@@ -24,6 +24,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from strapdown.ahrs.flags import MeasurementFlag
 from strapdown.algorithms._kernels import _update
 
 # indices into the parameter vector (see strapdown.ahrs._params)
@@ -62,16 +63,16 @@ P_ACC_GATE_LP = 31
 P_ACC_BIAS_RW = 32
 N_PARAMS = 33
 
-# flags per output
-F_ACC_USED = 1
-F_ACC_REJECTED = 2
-F_MAG_USED = 4
-F_MAG_REJECTED = 8
-F_MAG_DISTURBED = 16
-F_REST = 32
-F_ACC_RECOVERED = 64
-F_MAG_RECOVERED = 128
-F_ACC_DISTURBED = 256
+# flags per output: the values of strapdown.ahrs.flags.MeasurementFlag as plain ints
+F_ACC_USED = int(MeasurementFlag.ACC_USED)
+F_ACC_REJECTED = int(MeasurementFlag.ACC_REJECTED)
+F_MAG_USED = int(MeasurementFlag.MAG_USED)
+F_MAG_REJECTED = int(MeasurementFlag.MAG_REJECTED)
+F_MAG_DISTURBED = int(MeasurementFlag.MAG_DISTURBED)
+F_REST = int(MeasurementFlag.REST)
+F_ACC_RECOVERED = int(MeasurementFlag.ACC_RECOVERED)
+F_MAG_RECOVERED = int(MeasurementFlag.MAG_RECOVERED)
+F_ACC_DISTURBED = int(MeasurementFlag.ACC_DISTURBED)
 
 
 @njit(cache=True, inline="always")

@@ -1,7 +1,7 @@
-"""Attitude and heading reference: a multiplicative error-state EKF (seed 001, eqs. 30–35).
+"""Attitude and heading reference: a multiplicative error-state EKF (Wang, Wang & Wang, eqs. 30–35).
 
-The filter (Wang, Wang & Wang's attitude filter, made well-posed as
-papers.md describes):
+The filter (Wang, Wang & Wang's attitude filter, rebuilt from the paper's text
+and made well-posed; docs/reproductions.md says what the paper leaves open):
 
 - **state** ``x = [δθ_b, δb_g, a_b]``: attitude error in the body frame
   (``q_true = q̂ ⊗ q(δθ_b)``), gyro-bias error, and the manoeuvre
@@ -39,7 +39,8 @@ Without a magnetometer heading is not observed: it is the gyro's integral from
 the initial yaw (0 unless ``q0`` is given) and :attr:`AhrsResult.heading_observed`
 is False.
 
-The per-sample loop is :func:`strapdown.ahrs._kernel.ekf_kernel` (numba).
+The per-sample loop is :func:`strapdown.ahrs._kernel.ekf_kernel` (numba); what
+each output did with its measurements is a :class:`strapdown.ahrs.flags.MeasurementFlag`.
 """
 
 from __future__ import annotations
@@ -51,6 +52,7 @@ import numpy as np
 
 from strapdown._core.validation import as_quaternions
 from strapdown.ahrs import _kernel as K
+from strapdown.ahrs.flags import MeasurementFlag
 from strapdown.rotation.quaternion import quat_multiply
 
 __all__ = ["AhrsConfig", "AhrsResult", "attitude_from_acc_mag", "ekf"]
@@ -230,7 +232,7 @@ class AhrsResult:
     accel : ndarray (m, 3)
         Estimated manoeuvre acceleration in the body frame, m/s².
     flags : ndarray (m,) of int
-        Bit set per output (see ``strapdown.ahrs._kernel.F_*``).
+        Bitwise or of :class:`~strapdown.ahrs.flags.MeasurementFlag` per output.
     nis : ndarray (m, 2)
         Accelerometer and heading NIS (NaN where there was no update).
     attitude_sigma : ndarray (m, 3)
@@ -254,8 +256,9 @@ class AhrsResult:
     config: AhrsConfig = field(repr=False, default_factory=AhrsConfig)
     acc_bias: np.ndarray | None = None
 
-    def fraction(self, flag: int) -> float:
-        """Share of outputs with a flag set (e.g. ``K.F_MAG_USED``)."""
+    def fraction(self, flag: MeasurementFlag | int) -> float:
+        """Share of outputs with any of ``flag``'s bits set (NaN without outputs), e.g.
+        ``result.fraction(MeasurementFlag.MAG_USED)``."""
         return float(np.mean((self.flags & flag) != 0)) if self.flags.size else math.nan
 
 

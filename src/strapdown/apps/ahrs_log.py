@@ -25,8 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from strapdown.ahrs import AhrsConfig, AhrsResult, ekf
-from strapdown.ahrs import _kernel as K
+from strapdown.ahrs import AhrsConfig, AhrsResult, MeasurementFlag, ekf
 from strapdown.io import check_rows, csv_columns, warn_implausible_rate, write_attitude
 from strapdown.io.files import write_text
 
@@ -112,9 +111,10 @@ def run_ahrs(imu, out, *, algorithm: str = "rate-single", frame: str = "ENU",
         "heading": ("magnetic" if res.config.declination_deg == 0 else "true")
         if res.heading_observed else "not observed (no magnetometer): gyro integral from yaw 0",
         "algorithm": algorithm, "samples": int(log.t.size), "outputs": int(res.t.size),
-        "accelerometer_used": res.fraction(K.F_ACC_USED),
-        "magnetometer_used": res.fraction(K.F_MAG_USED) if res.heading_observed else 0.0,
-        "rest_updates": res.fraction(K.F_REST),
+        "accelerometer_used": res.fraction(MeasurementFlag.ACC_USED),
+        "magnetometer_used": (res.fraction(MeasurementFlag.MAG_USED) if res.heading_observed
+                              else 0.0),
+        "rest_updates": res.fraction(MeasurementFlag.REST),
         "config": asdict(res.config),
     }
     write_text(out.with_name(out.name + ".meta.json"), json.dumps(meta, indent=2))
