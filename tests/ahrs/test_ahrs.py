@@ -35,17 +35,29 @@ def _motion():
     return SpinConing(math.radians(20.0), 2 * math.pi * 0.3, math.radians(30.0))
 
 
+def _plain_python(monkeypatch):
+    """Run the kernel as plain Python: it and every compiled function it calls (the stages,
+    their helpers, the quaternion update) replaced by their ``py_func``."""
+    from numba.core.registry import CPUDispatcher
+
+    compiled = {n: f for n, f in vars(K).items() if isinstance(f, CPUDispatcher)}
+    assert {"ekf_kernel", "_joseph", "_window_step", "_reset", "_update"} <= set(compiled)
+    for name, f in compiled.items():
+        monkeypatch.setattr(K, name, f.py_func)
+
+
 @pytest.mark.parametrize("alg", ALGS)
 def test_kernel_matches_its_plain_python_execution(alg, monkeypatch):
     h = 0.01
     t = np.arange(120) * h
     q, w, acc, mag = _imu(_motion(), t, bias=(0.01, -0.02, 0.005))
     fast = ekf(t, w, acc, mag, algorithm=alg, q0=q[0])
-    monkeypatch.setattr(K, "ekf_kernel", K.ekf_kernel.py_func)
+    _plain_python(monkeypatch)
     slow = ekf(t, w, acc, mag, algorithm=alg, q0=q[0])
     assert np.array_equal(fast.index, slow.index) and np.array_equal(fast.flags, slow.flags)
     assert np.allclose(fast.q, slow.q, rtol=0, atol=1e-13)
     assert np.allclose(fast.gyro_bias, slow.gyro_bias, rtol=0, atol=1e-13)
+    assert np.allclose(fast.attitude_sigma, slow.attitude_sigma, rtol=1e-12, atol=0)
 
 
 @pytest.mark.parametrize("alg", ALGS)
@@ -266,7 +278,7 @@ def test_accelerometer_bias_state(monkeypatch):
     # the 12-state kernel against its plain execution
     short = slice(0, 150)
     fast = ekf(t[short], w[short], acc[short] + ba, mag[short], q0=q[0], config=cfg)
-    monkeypatch.setattr(K, "ekf_kernel", K.ekf_kernel.py_func)
+    _plain_python(monkeypatch)
     slow = ekf(t[short], w[short], acc[short] + ba, mag[short], q0=q[0], config=cfg)
     assert np.allclose(fast.q, slow.q, rtol=0, atol=1e-13)
     assert np.allclose(fast.acc_bias, slow.acc_bias, rtol=0, atol=1e-13)

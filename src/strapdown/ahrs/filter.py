@@ -46,6 +46,7 @@ each output did with its measurements is a :class:`strapdown.ahrs.flags.Measurem
 from __future__ import annotations
 
 import math
+import typing
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
@@ -347,42 +348,6 @@ def _algorithm(spec: str):
                      f"rotvec:N=…, not {alg!r}")
 
 
-def _params(cfg: AhrsConfig, ref, use_mag: bool) -> np.ndarray:
-    p = np.zeros(K.N_PARAMS)
-    p[K.P_GYRO_NOISE] = cfg.gyro_noise
-    p[K.P_BIAS_RW] = cfg.gyro_bias_rw
-    p[K.P_SINGER_SIGMA] = cfg.singer_sigma
-    p[K.P_SINGER_TAU] = cfg.singer_tau
-    p[K.P_ACC_NOISE] = cfg.acc_noise
-    p[K.P_HEADING_NOISE] = cfg.heading_noise
-    p[K.P_ACC_GATE] = cfg.acc_gate
-    p[K.P_MAG_GATE] = cfg.mag_gate
-    p[K.P_MAG_NORM_TOL] = cfg.mag_norm_tol
-    p[K.P_MAG_DIP_TOL] = cfg.mag_dip_tol
-    p[K.P_REF_NORM], p[K.P_REF_DIP], p[K.P_REF_HEADING] = ref
-    p[K.P_RECOVER_ACC] = cfg.recover_acc_s
-    p[K.P_RECOVER_MAG] = cfg.recover_mag_s
-    p[K.P_REST_GYRO] = cfg.rest_gyro
-    p[K.P_REST_ACC] = cfg.rest_acc
-    p[K.P_REST_NOISE] = cfg.rest_noise
-    p[K.P_REST_TAU] = cfg.rest_tau
-    p[K.P_USE_ACC] = float(cfg.use_accelerometer)
-    p[K.P_USE_MAG] = float(use_mag)
-    p[K.P_GATING] = float(cfg.gating)
-    p[K.P_USE_REST] = float(cfg.rest_update)
-    p[K.P_GRAVITY] = cfg.gravity
-    p[K.P_RECOVER_ANGLE] = cfg.recover_angle
-    p[K.P_ACC_NORM_TOL] = cfg.acc_norm_tol
-    p[K.P_MAG_SETTLE] = cfg.mag_settle_s
-    p[K.P_SOFT_ACC] = float(cfg.acc_gate_mode == "soft")
-    p[K.P_LEVER] = cfg.lever_arm
-    p[K.P_ACC_LP_TAU] = cfg.acc_lowpass_s if cfg.acc_model == "lowpass" else 0.0
-    p[K.P_ACC_LP_NOISE] = cfg.acc_lowpass_noise
-    p[K.P_ACC_GATE_LP] = cfg.acc_gate_lowpass
-    p[K.P_ACC_BIAS_RW] = cfg.acc_bias_rw
-    return p
-
-
 def _check(name, a, n):
     a = np.ascontiguousarray(a, dtype=np.float64)
     if a.shape != (n, 3):
@@ -393,10 +358,152 @@ def _check(name, a, n):
     return a
 
 
+def _validate(t, gyro, acc, mag, cfg: AhrsConfig, frame: str):
+    """The record checked: (rate record, acc, mag — zeros when absent —, heading observed).
+
+    Raises ValueError naming the problem: the frame, the time stamps and gyro
+    (:func:`strapdown.algorithms.rate.check_rate_record`), the shapes, a NaN's
+    row, an accelerometer not in m/s² of specific force, a magnetometer reading zero.
+    """
+    from strapdown.algorithms.rate import check_rate_record
+
+    if frame not in ("ENU", "NED"):
+        raise ValueError(f"frame must be 'ENU' or 'NED', got {frame!r}")
+    rec = check_rate_record(t, gyro, min_samples=4)
+    n = rec.t.size
+    acc = _check("acc", acc, n)
+    have_mag = mag is not None and cfg.use_magnetometer
+    mag = _check("mag", mag, n) if mag is not None else np.zeros((n, 3))
+    a_norm = np.median(np.linalg.norm(acc, axis=1))
+    if not 0.5 * cfg.gravity < a_norm < 2.0 * cfg.gravity:
+        raise ValueError(f"the accelerometer's median norm is {a_norm:.4g}; expected about "
+                         f"{cfg.gravity} m/s² (is it in g, or not specific force?)")
+    if have_mag and np.median(np.linalg.norm(mag, axis=1)) == 0:
+        raise ValueError("the magnetometer reads zero; pass mag=None for no heading")
+    return rec, acc, mag, have_mag
+
+
+def _init_window(rec, cfg: AhrsConfig) -> int:
+    """Samples of the initial window (at least 2, at most the record)."""
+    return max(2, min(rec.t.size, round(cfg.init_window_s / rec.td)))
+
+
+def _initial_attitude(rec, acc, mag, have_mag: bool, cfg: AhrsConfig, q0, frame: str):
+    """q_ENU_b at the start and the body-frame field there (None without heading).
+
+    Without ``q0`` the initial window is assumed at rest: its mean specific
+    force and field give the attitude by TRIAD (:func:`attitude_from_acc_mag`).
+    """
+    if q0 is None:
+        w = _init_window(rec, cfg)
+        m0 = mag[:w].mean(axis=0) if have_mag else None
+        return attitude_from_acc_mag(acc[:w].mean(axis=0), m0,
+                                     declination_deg=cfg.declination_deg), m0
+    q_init = as_quaternions(q0, "q0").reshape(4)
+    q_init = q_init / np.linalg.norm(q_init)
+    if frame == "NED":  # the filter runs in ENU
+        q_init = quat_multiply(np.array([0.0, -Q_NED_ENU[1], -Q_NED_ENU[2], 0.0]), q_init)
+    return q_init, (mag[0] if have_mag else None)
+
+
+def _reference_field(rec, mag, q_init, m0, q0, mag_reference, cfg: AhrsConfig):
+    """(norm, dip, heading) of the local field in ENU — dip down positive, heading from
+    east to north, rad — given (``mag_reference``), or learned (see :func:`ekf`)."""
+    from strapdown.rotation.dcm import dcm_from_quat
+
+    if mag_reference is not None:  # the local field is known (ENU)
+        mn = np.asarray(mag_reference, float)
+        if mn.shape != (3,) or not np.all(np.isfinite(mn)) or not np.linalg.norm(mn) > 0:
+            raise ValueError(f"mag_reference must be a finite non-zero (3,) ENU vector, "
+                             f"got {mag_reference!r}")
+    elif q0 is None:
+        mn = dcm_from_quat(q_init) @ m0
+    else:  # learn the field over the window along the gyro-propagated attitude
+        from strapdown.algorithms.rate import rate_attitude
+
+        w = _init_window(rec, cfg)
+        qw = rate_attitude(rec.t[:w], rec.omega[:w], algorithm="rate-single", q0=q_init).q
+        mn = np.einsum("nij,nj->ni", dcm_from_quat(qw), mag[:w]).mean(axis=0)
+    return (float(np.linalg.norm(mn)), math.atan2(-mn[2], math.hypot(mn[0], mn[1])),
+            math.atan2(mn[1], mn[0]))
+
+
+# Params fields that are not AhrsConfig fields of the same name and meaning
+_DERIVED = ("ref_norm", "ref_dip", "ref_heading", "use_magnetometer", "soft_gate",
+            "acc_lowpass")
+
+
+def _params(cfg: AhrsConfig, ref, use_mag: bool) -> K.Params:
+    """The kernel's parameter record: the config's fields of the same name, the reference
+    field ``ref`` (norm, dip, heading), and the switches derived from the config.
+
+    Every value is converted to its field's type (float or bool), so the
+    compiled kernel's signature — and numba's cache entry — never changes.
+    """
+    derived = dict(zip(_DERIVED[:3], ref, strict=True), use_magnetometer=use_mag,
+                   soft_gate=cfg.acc_gate_mode == "soft", acc_lowpass=cfg.acc_model == "lowpass")
+    types = typing.get_type_hints(K.Params)
+    return K.Params(**{f: types[f](derived[f] if f in derived else getattr(cfg, f))
+                       for f in K.Params._fields})
+
+
+def _propagation(a: dict) -> tuple[K.Propagation, K.Window]:
+    """The kernel's propagation records from :func:`_algorithm`'s dict, types fixed (so
+    the compiled kernel's signature never changes)."""
+    prop = K.Propagation(is_rate=bool(a["is_rate"]), stride=int(a["stride"]),
+                         end_off=int(a["end_off"]), lag=int(a["lag"]),
+                         start_c=float(a["start_c"]), rk4=bool(a["rk4"]))
+    window = K.Window(*(np.ascontiguousarray(a[f], np.int64 if f in ("offsets", "pi", "pj")
+                                             else np.float64) for f in K.Window._fields))
+    return prop, window
+
+
+def _initial_covariance(cfg: AhrsConfig) -> np.ndarray:
+    """P0: attitude, gyro bias, manoeuvre acceleration (and accelerometer bias)."""
+    nx = 12 if cfg.estimate_acc_bias else 9
+    P0 = np.zeros((nx, nx))
+    P0[:3, :3] = np.eye(3) * cfg.attitude_sigma0**2
+    P0[3:6, 3:6] = np.eye(3) * cfg.gyro_bias_sigma0**2
+    P0[6:9, 6:9] = np.eye(3) * cfg.singer_sigma**2
+    if nx == 12:
+        P0[9:, 9:] = np.eye(3) * cfg.acc_bias_sigma0**2
+    return P0
+
+
+def _run(rec, acc, mag, prop: K.Propagation, window: K.Window, params: K.Params,
+         init: K.Initial):
+    """Run the compiled loop; returns (outputs, number of rows written)."""
+    h = rec.td
+    x = rec.omega if prop.is_rate else 0.5 * h * (rec.omega[1:] + rec.omega[:-1])
+    m = rec.t.size  # at most one output per sample
+    out = K.Outputs(q=np.empty((m, 4)), gyro_bias=np.empty((m, 3)), accel=np.empty((m, 3)),
+                    acc_bias=np.empty((m, 3)), index=np.empty(m, np.int64),
+                    flags=np.empty(m, np.int64), nis=np.empty((m, 2)),
+                    attitude_sigma=np.empty((m, 3)))
+    k = K.ekf_kernel(K.Sensors(np.ascontiguousarray(x), acc, mag, float(h)), prop, window,
+                     params, init, out)
+    return out, k
+
+
+def _result(rec, out: K.Outputs, k: int, frame: str, have_mag: bool, algorithm: str,
+            cfg: AhrsConfig) -> AhrsResult:
+    """The first k output rows as an :class:`AhrsResult` in ``frame``."""
+    q = out.q[:k]
+    if frame == "NED":
+        q = quat_multiply(Q_NED_ENU, q)
+    idx = out.index[:k]
+    return AhrsResult(rec.t[idx], idx, q, frame, have_mag, out.gyro_bias[:k], out.accel[:k],
+                      out.flags[:k], out.nis[:k], out.attitude_sigma[:k], algorithm, cfg,
+                      out.acc_bias[:k] if cfg.estimate_acc_bias else None)
+
+
 def ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
         config: AhrsConfig | None = None, q0=None, gyro_bias0=None,
         mag_reference=None, frame: str = "ENU") -> AhrsResult:
     """Run the AHRS filter over uniformly sampled gyro, accelerometer and magnetometer data.
+
+    The multiplicative error-state EKF of Wang, Wang & Wang (eqs. 30–35), made
+    well-posed (see the module docstring).
 
     Parameters
     ----------
@@ -421,84 +528,23 @@ def ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
         over ``init_window_s`` — averaged at rest when ``q0`` is None, else
         rotated into the reference frame along the gyro-propagated attitude.
     frame : {"ENU", "NED"}
+
+    Returns
+    -------
+    AhrsResult
+
+    Raises
+    ------
+    ValueError
+        On invalid input, naming the problem.
     """
-    from strapdown.algorithms.rate import check_rate_record
-
     cfg = config or AhrsConfig()
-    if frame not in ("ENU", "NED"):
-        raise ValueError(f"frame must be 'ENU' or 'NED', got {frame!r}")
-    rec = check_rate_record(t, gyro, min_samples=4)
-    n = rec.t.size
-    h = rec.td
-    acc = _check("acc", acc, n)
-    have_mag = mag is not None and cfg.use_magnetometer
-    mag = _check("mag", mag, n) if mag is not None else np.zeros((n, 3))
-    a_norm = np.median(np.linalg.norm(acc, axis=1))
-    if not 0.5 * cfg.gravity < a_norm < 2.0 * cfg.gravity:
-        raise ValueError(f"the accelerometer's median norm is {a_norm:.4g}; expected about "
-                         f"{cfg.gravity} m/s² (is it in g, or not specific force?)")
-    if have_mag and np.median(np.linalg.norm(mag, axis=1)) == 0:
-        raise ValueError("the magnetometer reads zero; pass mag=None for no heading")
-    w = max(2, min(n, round(cfg.init_window_s / h)))
-    if q0 is None:  # the initial window is assumed at rest: average it
-        f0 = acc[:w].mean(axis=0)
-        m0 = mag[:w].mean(axis=0) if have_mag else None
-    else:
-        f0 = acc[0]
-        m0 = mag[0] if have_mag else None
-    if q0 is None:
-        q_init = attitude_from_acc_mag(f0, m0, declination_deg=cfg.declination_deg)
-    else:
-        q_init = as_quaternions(q0, "q0").reshape(4)
-        q_init = q_init / np.linalg.norm(q_init)
-        if frame == "NED":  # the filter runs in ENU
-            q_init = quat_multiply(np.array([0.0, -Q_NED_ENU[1], -Q_NED_ENU[2], 0.0]), q_init)
-    from strapdown.rotation.dcm import dcm_from_quat
-
-    ref = (0.0, 0.0, 0.0)
-    if have_mag:
-        if mag_reference is not None:  # the local field is known (ENU)
-            mn = np.asarray(mag_reference, float)
-            if mn.shape != (3,) or not np.all(np.isfinite(mn)) or not np.linalg.norm(mn) > 0:
-                raise ValueError(f"mag_reference must be a finite non-zero (3,) ENU vector, "
-                                 f"got {mag_reference!r}")
-        elif q0 is None:
-            mn = dcm_from_quat(q_init) @ m0
-        else:  # learn the field over the window along the gyro-propagated attitude
-            from strapdown.algorithms.rate import rate_attitude
-
-            qw = rate_attitude(rec.t[:w], rec.omega[:w], algorithm="rate-single", q0=q_init).q
-            mn = np.einsum("nij,nj->ni", dcm_from_quat(qw), mag[:w]).mean(axis=0)
-        ref = (float(np.linalg.norm(mn)), math.atan2(-mn[2], math.hypot(mn[0], mn[1])),
-               math.atan2(mn[1], mn[0]))
+    rec, acc, mag, have_mag = _validate(t, gyro, acc, mag, cfg, frame)
+    q_init, m0 = _initial_attitude(rec, acc, mag, have_mag, cfg, q0, frame)
+    ref = (_reference_field(rec, mag, q_init, m0, q0, mag_reference, cfg) if have_mag
+           else (0.0, 0.0, 0.0))
     b0 = np.zeros(3) if gyro_bias0 is None else _check("gyro_bias0", [gyro_bias0], 1)[0]
-    a = _algorithm(algorithm)
-    x = rec.omega if a["is_rate"] else 0.5 * h * (rec.omega[1:] + rec.omega[:-1])
-    nx = 12 if cfg.estimate_acc_bias else 9
-    P0 = np.zeros((nx, nx))
-    P0[:3, :3] = np.eye(3) * cfg.attitude_sigma0**2
-    P0[3:6, 3:6] = np.eye(3) * cfg.gyro_bias_sigma0**2
-    P0[6:9, 6:9] = np.eye(3) * cfg.singer_sigma**2
-    if nx == 12:
-        P0[9:, 9:] = np.eye(3) * cfg.acc_bias_sigma0**2
-    m = n  # at most one output per sample
-    out_q = np.empty((m, 4))
-    out_b = np.empty((m, 3))
-    out_a = np.empty((m, 3))
-    out_ab = np.empty((m, 3))
-    out_idx = np.empty(m, np.int64)
-    out_flags = np.empty(m, np.int64)
-    out_nis = np.empty((m, 2))
-    out_sig = np.empty((m, 3))
-    k = K.ekf_kernel(np.ascontiguousarray(x), a["is_rate"], h, a["offsets"], a["weights"],
-                     a["pi"], a["pj"], a["pc"], a["stride"], a["span"], a["end_off"], a["lag"],
-                     a["start_c"], a["rk4"], acc, mag, _params(cfg, ref, have_mag), q_init, b0,
-                     P0, out_q, out_b, out_a, out_ab, out_idx, out_flags, out_nis, out_sig)
-    q = out_q[:k]
-    if frame == "NED":
-        q = quat_multiply(Q_NED_ENU, q)
-    idx = out_idx[:k]
-    return AhrsResult(rec.t[idx], idx, q, frame, have_mag, out_b[:k], out_a[:k], out_flags[:k],
-                      out_nis[:k], out_sig[:k], algorithm, cfg,
-                      out_ab[:k] if cfg.estimate_acc_bias else None)
-
+    prop, window = _propagation(_algorithm(algorithm))
+    init = K.Initial(q_init, b0, _initial_covariance(cfg))
+    out, k = _run(rec, acc, mag, prop, window, _params(cfg, ref, have_mag), init)
+    return _result(rec, out, k, frame, have_mag, algorithm, cfg)
