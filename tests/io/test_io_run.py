@@ -63,8 +63,10 @@ def test_validation_rows(tmp_path, mutate, msg):
 def test_gaps_and_columns(tmp_path):
     t = np.r_[np.arange(10), np.arange(20, 30)] / 100.0
     _csv(tmp_path / "log.csv", t, np.zeros((20, 3)), names=("time", "a", "b", "c"))
-    with pytest.raises(ValueError, match="not in the header"):
+    with pytest.raises(ValueError, match=r"no gyro columns in the header \['time', 'a'"):
         read_imu(tmp_path / "log.csv", kind="rate", units="rad/s")
+    with pytest.raises(ValueError, match="not in the header"):
+        read_imu(tmp_path / "log.csv", kind="rate", units="rad/s", columns=("t", "a", "b", "c"))
     log = read_imu(tmp_path / "log.csv", kind="rate", units="rad/s",
                    columns=("time", "a", "b", "c"))
     assert log.gaps == [11]
