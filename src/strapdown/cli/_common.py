@@ -15,11 +15,9 @@ from collections.abc import Callable, Iterable
 from typing import TYPE_CHECKING, TypeVar
 
 if TYPE_CHECKING:
-    from strapdown.algorithms.family import Family
+    from strapdown.algorithms.family import AlgorithmName, Family
 
 __all__ = [
-    "INCREMENT_UNITS",
-    "RATE_UNITS",
     "CommandParser",
     "HelpFormatter",
     "Parser",
@@ -36,10 +34,6 @@ __all__ = [
     "say",
     "structure_help",
 ]
-
-#: Units of a rate log and of an increment log (what :func:`strapdown.io.read_imu` accepts).
-RATE_UNITS = ("rad/s", "deg/s")
-INCREMENT_UNITS = ("rad", "deg")
 
 #: Where options go: a parser or one of its argument groups.
 Options = argparse.ArgumentParser | argparse._ArgumentGroup
@@ -165,6 +159,8 @@ def log_args(p: argparse.ArgumentParser, *, imu_help: str, required: bool,
     optional (``compare`` runs on a motion without one, and its ``--sample-rate-hz`` is the
     motion's, see :func:`motion_args`).
     """
+    from strapdown.io.readers import INCREMENT_UNITS, RATE_UNITS
+
     g = p.add_argument_group("gyro log")
     g.add_argument("--imu", required=required, help=imu_help)
     kind = g.add_mutually_exclusive_group(required=required)
@@ -186,8 +182,10 @@ def log_args(p: argparse.ArgumentParser, *, imu_help: str, required: bool,
 
 def log_check_args(p: argparse.ArgumentParser) -> None:
     """What to do about a log's faults: ``--on-gap``, ``--gap-tolerance``, ``--saturation``."""
+    from strapdown.apps.run import RUN_GAP_POLICIES
+
     g = p.add_argument_group("log checks")
-    g.add_argument("--on-gap", choices=["report", "error", "split"], default="report",
+    g.add_argument("--on-gap", choices=RUN_GAP_POLICIES, default="report",
                    help="gaps (intervals over --gap-tolerance samples): report them, fail, or "
                    "run each gap-free segment separately")
     g.add_argument("--gap-tolerance", type=float, default=1.5,
@@ -214,7 +212,8 @@ def progress(args: argparse.Namespace) -> bool:
 
 
 # ------------------------------------------------------------------------------ registry help
-def _by_family(names: Iterable[str], key: Callable[[Family], _K]) -> list[tuple[str, _K]]:
+def _by_family(names: Iterable[AlgorithmName], key: Callable[[Family], _K]
+               ) -> list[tuple[str, _K]]:
     """``[("a, b", value), …]``: the families among ``names`` grouped by ``key(family)``."""
     from strapdown.algorithms.spec import REGISTRY
 
@@ -224,7 +223,7 @@ def _by_family(names: Iterable[str], key: Callable[[Family], _K]) -> list[tuple[
     return [(", ".join(ns), value) for value, ns in groups.items()]
 
 
-def algorithm_help(names: Iterable[str]) -> str:
+def algorithm_help(names: Iterable[AlgorithmName]) -> str:
     """What each of ``names`` (registered families) takes as input."""
     def kind(f: Family) -> str:
         if f.stepped:
@@ -234,7 +233,7 @@ def algorithm_help(names: Iterable[str]) -> str:
     return "; ".join(f"{ns}: {what}" for ns, what in _by_family(names, kind))
 
 
-def coefficients_help(names: Iterable[str]) -> str:
+def coefficients_help(names: Iterable[AlgorithmName]) -> str:
     """The coefficient sets each of ``names`` takes, its default first."""
     def sets(f: Family) -> tuple[tuple[str, ...], str | None]:
         return tuple(f.coefficient_names()), f.default_coefficients
@@ -247,7 +246,7 @@ def coefficients_help(names: Iterable[str]) -> str:
     return "; ".join(parts)
 
 
-def structure_help(names: Iterable[str]) -> str:
+def structure_help(names: Iterable[AlgorithmName]) -> str:
     """The update structures each of ``names`` runs in, its default first."""
     groups = _by_family(names, lambda f: f.structures)
     return ("update structure; " + "; ".join(f"{ns}: {', '.join(st)}" for ns, st in groups)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from strapdown.cli._common import RATE_UNITS, columns, say
+from strapdown.cli._common import columns, say
 
 __all__ = ["add_parser", "run"]
 
@@ -24,6 +24,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 def _arguments(p: argparse.ArgumentParser) -> None:
     from strapdown.apps.ahrs_log import DEFAULT_COLUMNS
+    from strapdown.io.readers import RATE_UNITS
 
     p.add_argument("--imu", required=True, help="recording (.mat BROAD, .csv)")
     p.add_argument("--out", required=True, help="output .csv or .npz")

@@ -22,7 +22,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 def _arguments(p: argparse.ArgumentParser) -> None:
     from strapdown.algorithms.spec import STRUCTURES
-    from strapdown.codegen.export_c import ALGORITHMS
+    from strapdown.codegen.export_c import ALGORITHMS, REALS
 
     p.add_argument("--algorithm", choices=ALGORITHMS, required=True,
                    help="the algorithm to generate")
@@ -31,7 +31,7 @@ def _arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--subsamples", type=int, default=3, help="N, subsamples per update (rotvec)")
     p.add_argument("--coefficients", default=None,
                    help="coefficient set; " + coefficients_help(ALGORITHMS))
-    p.add_argument("--float", dest="real", choices=["double", "float"], default="double",
+    p.add_argument("--float", dest="real", choices=REALS, default="double",
                    help="C floating-point type of the state and the arithmetic")
     p.add_argument("--sample-rate-hz", type=float, default=10_000.0,
                    help="rate algorithms: 1/td, baked into the code")

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+from typing import TYPE_CHECKING
 
 from strapdown.cli._common import (
     algorithm_help,
@@ -15,6 +16,9 @@ from strapdown.cli._common import (
     say,
     structure_help,
 )
+
+if TYPE_CHECKING:
+    from strapdown.algorithms.family import AlgorithmName
 
 __all__ = ["add_parser", "run"]
 
@@ -30,7 +34,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     return p
 
 
-def log_algorithms() -> tuple[str, ...]:
+def log_algorithms() -> tuple[AlgorithmName, ...]:
     """The families that run on a log (not the quaternion algorithms' whole steps)."""
     from strapdown.algorithms.spec import REGISTRY
 
@@ -39,6 +43,7 @@ def log_algorithms() -> tuple[str, ...]:
 
 def _arguments(p: argparse.ArgumentParser) -> None:
     from strapdown.algorithms.spec import STRUCTURES
+    from strapdown.apps.run import ANGLES
 
     log_args(p, imu_help="input log", required=True, sample_rate=True)
     log_check_args(p)
@@ -52,7 +57,7 @@ def _arguments(p: argparse.ArgumentParser) -> None:
     g.add_argument("--coefficients", default=None,
                    help="coefficient set; " + coefficients_help(algorithms))
     o = p.add_argument_group("output")
-    o.add_argument("--angles", choices=["ypr", "cone", "none"], default="ypr",
+    o.add_argument("--angles", choices=ANGLES, default="ypr",
                    help="angles written beside the quaternion: yaw/pitch/roll, cone angles, or "
                    "none (deg)")
     progress_args(o)
