@@ -57,22 +57,31 @@ lowest degrees first, then minimum norm) or ``"min-norm"``.
 from __future__ import annotations
 
 import functools
+from collections.abc import Sequence
 from dataclasses import dataclass
 from fractions import Fraction
 from itertools import pairwise
 from math import factorial
+from typing import Any, Literal, get_args
 
 import numpy as np
 import sympy as sp
 
+from strapdown._core.kinds import INPUT_KINDS, InputKind
 from strapdown._core.validation import positive_int
 from strapdown.algorithms.coning import CoefficientSet, WindowedAlgorithm
+from strapdown.algorithms.family import Rk4Step
 
 __all__ = [
     "FORMS",
+    "LAYOUTS",
     "RULES",
     "TARGETS",
     "Design",
+    "DesignRule",
+    "DesignTarget",
+    "Form",
+    "Layout",
     "Structure",
     "classical_coning_drift",
     "derive",
@@ -87,9 +96,18 @@ __all__ = [
 ]
 
 F = Fraction
-TARGETS = ("coning", "polynomial", "sculling")
-RULES = ("polynomial", "min-norm")
-LAYOUTS = ("all-pairs", "cross-with-last", "lag")
+#: What a derivation cancels (see the module docstring).
+DesignTarget = Literal["coning", "polynomial", "sculling"]
+TARGETS: tuple[DesignTarget, ...] = get_args(DesignTarget)
+#: How coefficients the target leaves free are settled.
+DesignRule = Literal["polynomial", "min-norm"]
+RULES: tuple[DesignRule, ...] = get_args(DesignRule)
+#: Which cross products of an update's nodes are free, and how they are tied: one per
+#: lag m with the last node (Li & Zhang Table 3), lag sums spread evenly, or every pair.
+Layout = Literal["cross-with-last", "lag", "all-pairs"]
+LAYOUTS: tuple[Layout, ...] = get_args(Layout)
+#: The structures ``strapdown coefficients --form`` names (:func:`structure_by_name`).
+Form = Literal[Layout, "single-chain", "uncompressed", "rate", "rate-three"]
 
 
 # --------------------------------------------------------------------------- structures
@@ -122,7 +140,7 @@ class Structure:
     """
 
     name: str
-    input: str
+    input: InputKind
     update: int
     nodes: tuple[Fraction, ...]
     weights: tuple[Fraction, ...]
@@ -131,7 +149,7 @@ class Structure:
     n: int
 
     def __post_init__(self):
-        if self.input not in ("increment", "rate"):
+        if self.input not in INPUT_KINDS:
             raise ValueError(f"input must be 'increment' or 'rate', got {self.input!r}")
         if len(self.weights) != len(self.nodes):
             raise ValueError("weights and nodes must have the same length")
@@ -182,7 +200,7 @@ def _pairs_and_groups(nodes, layout, current_from, last):
     return tuple(pairs), tuple(groups)
 
 
-def interval_structure(n: int, layout: str = "cross-with-last") -> Structure:
+def interval_structure(n: int, layout: Layout = "cross-with-last") -> Structure:
     """N increments inside one update interval (the conventional structure)."""
     n = positive_int(n, "N (subsamples)")
     nodes = _nodes(0, n)
@@ -190,7 +208,8 @@ def interval_structure(n: int, layout: str = "cross-with-last") -> Structure:
     return Structure(f"{layout}, N = {n}", "increment", n, nodes, (F(1),) * n, pairs, groups, n)
 
 
-def uncompressed_structure(n: int, previous: int, layout: str = "cross-with-last") -> Structure:
+def uncompressed_structure(n: int, previous: int, layout: Layout = "cross-with-last"
+                           ) -> Structure:
     """N current increments plus ``previous`` increments of earlier intervals ("uncompressed").
 
     Cross products pair a current increment with any earlier one (current or
@@ -231,7 +250,9 @@ def newton_cotes_weights(nodes, update: int) -> tuple[Fraction, ...]:
     return tuple(F(int(sp.fraction(v)[0]), int(sp.fraction(v)[1])) for v in sol)
 
 
-def rate_structure(n: int, layout: str = "all-pairs", weights=None, nodes=None) -> Structure:
+def rate_structure(n: int, layout: Layout = "all-pairs",
+                   weights: Sequence[Fraction | int | float | str] | None = None,
+                   nodes: Sequence[Fraction | int | float | str] | None = None) -> Structure:
     """Rate samples at nodes of an update of N sample intervals (default 0, 1, …, N).
 
     ``α = h Σ w_n ω_n`` (Newton–Cotes on the nodes by default: exact for
@@ -252,17 +273,17 @@ def rate_structure(n: int, layout: str = "all-pairs", weights=None, nodes=None) 
 
 
 def three_period_structure() -> Structure:
-    """Seed 001's three-period rate algorithm: ω1…ω4 at 0, T/3, 2T/3, T, Simpson 3/8 α, lag sums."""
+    """Wang, Wang & Wang's three-period rate algorithm: ω1…ω4 at 0, T/3, 2T/3, T, Simpson 3/8
+    α, lag sums."""
     s = rate_structure(3, "lag", weights=[F(3, 8), F(9, 8), F(9, 8), F(3, 8)])
     return Structure("rate three-period (Wang et al.), lag sums", s.input, s.update, s.nodes,
                      s.weights, s.pairs, s.groups, 3)
 
 
-FORMS = ("cross-with-last", "lag", "all-pairs", "single-chain", "uncompressed", "rate",
-         "rate-three")
+FORMS: tuple[Form, ...] = get_args(Form)
 
 
-def structure_by_name(form: str, n: int, *, previous: int | None = None) -> Structure:
+def structure_by_name(form: Form, n: int, *, previous: int | None = None) -> Structure:
     """The structure a CLI ``--form`` names (``uncompressed`` defaults to N previous increments)."""
     if form in LAYOUTS:
         return interval_structure(n, form)
@@ -494,8 +515,8 @@ class Design:
     """
 
     structure: Structure
-    target: str
-    rule: str
+    target: DesignTarget
+    rule: DesignRule
     coefficients: tuple[Fraction, ...]
     order: int | None
     drift_constant: Fraction | None
@@ -508,7 +529,7 @@ class Design:
 
     def predicted_drift(self, half_angle: float, cone_rate: float, h: float) -> float:
         """Leading-order drift about the cone axis (rad/s)."""
-        if self.order is None:
+        if self.order is None or self.drift_constant is None:  # both None together
             return 0.0
         return -float(self.drift_constant) * half_angle**2 * cone_rate * (cone_rate * h) ** (
             self.order)
@@ -539,7 +560,7 @@ class Design:
                                  st.weights, st.pairs, self.coefficients,
                                  f"{st.name} ({self.target})")
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
         """The documented JSON record of ``strapdown coefficients``."""
         return {
             "form": self.structure.name,
@@ -587,7 +608,7 @@ def classical_coning_drift(structure: Structure, coefficients, *, quadrature: bo
     return _leading(structure, coeffs, e0, pair_series, terms)
 
 
-def rk4_classical_coning_drift(step: str = "2td", terms: int = 12) -> tuple[int, Fraction]:
+def rk4_classical_coning_drift(step: Rk4Step = "2td", terms: int = 12) -> tuple[int, Fraction]:
     """Classical-coning drift ``(order, c)`` of quaternion RK4 on rate samples (sympy).
 
     One normalised RK4 step on ``q̇ = ½ q ⊗ ω`` is ``q ⊗ P/|P|`` with ``P`` a
@@ -653,7 +674,8 @@ def _frac(v) -> Fraction:
     return F(int(n), int(d))
 
 
-def derive(structure: Structure, *, target: str = "coning", rule: str = "polynomial",
+def derive(structure: Structure, *, target: DesignTarget = "coning",
+           rule: DesignRule = "polynomial",
            quadrature: bool = True) -> Design:
     """Derive a structure's coefficients exactly.
 
@@ -681,7 +703,7 @@ def derive(structure: Structure, *, target: str = "coning", rule: str = "polynom
 
 
 @functools.lru_cache(maxsize=256)
-def _derive(st: Structure, target: str, rule: str, quadrature: bool) -> Design:
+def _derive(st: Structure, target: DesignTarget, rule: DesignRule, quadrature: bool) -> Design:
     ng = len(st.groups)
     npair = len(st.pairs)
     # group → pair expansion matrix G (npair × ng)
@@ -711,7 +733,7 @@ def _derive(st: Structure, target: str, rule: str, quadrature: bool) -> Design:
         conditions = len(a)
     u = _min_norm(a, b, ng)
     ug = [_frac(v) for v in u]
-    coeffs = tuple(sum(g[k][c] * ug[c] for c in range(ng)) for k in range(npair))
+    coeffs = tuple(sum((g[k][c] * ug[c] for c in range(ng)), F(0)) for k in range(npair))
     order, const = _leading(st, coeffs, e0, pair_series, m)
     rule_used = rule if target in ("coning", "sculling") else "min-norm"
     return Design(st, target, rule_used, coeffs, order, const, quadrature, conditions)

@@ -19,8 +19,10 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Any, Literal, get_args
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 from scipy import optimize as so
 
 from strapdown import analysis
@@ -32,8 +34,11 @@ from strapdown.design import Structure
 from strapdown.truth.motions import Motion
 
 __all__ = [
+    "METHODS",
     "METRICS",
+    "ObjectiveMetric",
     "OptimizationResult",
+    "OptimizerMethod",
     "TransferCase",
     "algorithm_from_groups",
     "optimize",
@@ -42,10 +47,16 @@ __all__ = [
     "windowed_objective",
 ]
 
-METRICS = ("drift-rate", "max-error")
+#: What an objective scores: the drift rate about the cone axis (or its norm without one), or
+#: the largest error.
+ObjectiveMetric = Literal["drift-rate", "max-error"]
+METRICS: tuple[ObjectiveMetric, ...] = get_args(ObjectiveMetric)
+#: The optimisers (see the module docstring).
+OptimizerMethod = Literal["nelder-mead", "differential-evolution"]
+METHODS: tuple[OptimizerMethod, ...] = get_args(OptimizerMethod)
 
 
-def algorithm_from_groups(structure: Structure, values: Sequence[float]) -> WindowedAlgorithm:
+def algorithm_from_groups(structure: Structure, values: ArrayLike) -> WindowedAlgorithm:
     """A structure's algorithm with its free groups set to ``values`` (one per group)."""
     vals = finite_array(values, "values")
     if vals.shape != (len(structure.groups),):
@@ -64,7 +75,8 @@ def algorithm_from_groups(structure: Structure, values: Sequence[float]) -> Wind
 
 
 def simulate_windowed(motion: Motion, algorithm: WindowedAlgorithm, *, h: float, updates: int,
-                      digits: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+                      digits: int | None = None
+                      ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Errors of a windowed algorithm on a motion (history sampled from the motion).
 
     Returns ``(t, err)`` with ``err`` the reference-frame error vectors at the
@@ -88,7 +100,8 @@ def simulate_windowed(motion: Motion, algorithm: WindowedAlgorithm, *, h: float,
     return sol.t, err
 
 
-def _metric(name: str, motion: Motion, t: np.ndarray, err: np.ndarray) -> float:
+def _metric(name: ObjectiveMetric, motion: Motion, t: NDArray[np.float64],
+            err: NDArray[np.float64]) -> float:
     if name == "drift-rate":
         d = analysis.drift_rate(t, err, period=motion.period)
         axis = motion.cone_axis
@@ -99,13 +112,13 @@ def _metric(name: str, motion: Motion, t: np.ndarray, err: np.ndarray) -> float:
 
 
 def windowed_objective(structure: Structure, motion: Motion, *, h: float, updates: int,
-                       metric: str = "drift-rate", digits: int | None = None
-                       ) -> Callable[[np.ndarray], float]:
+                       metric: ObjectiveMetric = "drift-rate", digits: int | None = None
+                       ) -> Callable[[NDArray[np.float64]], float]:
     """Objective ``values → metric`` for a structure's free groups on one motion."""
     if metric not in METRICS:
         raise ValueError(f"unknown metric {metric!r}; choose one of {', '.join(METRICS)}")
 
-    def f(values) -> float:
+    def f(values: NDArray[np.float64]) -> float:
         alg = algorithm_from_groups(structure, values)
         t, err = simulate_windowed(motion, alg, h=h, updates=updates, digits=digits)
         return _metric(metric, motion, t, err)
@@ -117,19 +130,21 @@ def windowed_objective(structure: Structure, motion: Motion, *, h: float, update
 class OptimizationResult:
     """Outcome of :func:`optimize`."""
 
-    x: np.ndarray
+    x: NDArray[np.float64]
     fun: float
-    start: np.ndarray
+    start: NDArray[np.float64]
     start_fun: float
-    method: str
+    method: OptimizerMethod
     evaluations: int
     seed: int | None
     message: str
 
 
-def optimize(objective: Callable[[np.ndarray], float], x0, *, method: str = "nelder-mead",
-             bounds=None, seed: int | None = None, xatol: float = 1e-12, fatol: float = 0.0,
-             maxiter: int = 2000) -> OptimizationResult:
+def optimize(objective: Callable[[NDArray[np.float64]], float], x0: ArrayLike, *,
+             method: OptimizerMethod = "nelder-mead",
+             bounds: Sequence[tuple[float, float]] | None = None, seed: int | None = None,
+             xatol: float = 1e-12, fatol: float = 0.0, maxiter: int = 2000
+             ) -> OptimizationResult:
     """Minimise ``objective`` reproducibly.
 
     Parameters
@@ -179,8 +194,8 @@ class TransferCase:
 
 
 def transfer(structure: Structure, sets: dict[str, Sequence[float]],
-             cases: Sequence[TransferCase], *, metric: str = "drift-rate",
-             digits: int | None = None) -> list[dict]:
+             cases: Sequence[TransferCase], *, metric: ObjectiveMetric = "drift-rate",
+             digits: int | None = None) -> list[dict[str, Any]]:
     """Evaluate coefficient sets (group values) on other conditions.
 
     Returns one record per (case, set): ``case``, ``set``, ``metric``,
