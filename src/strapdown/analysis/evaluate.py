@@ -224,6 +224,7 @@ class Evaluation:
         c = self.config
         return judge_law(self.cone_axis_drift, self.predicted,
                          half_angle=math.radians(c.half_angle_deg), duration=c.duration,
+                         updates=max(1.0, c.duration / self.update_period),
                          digits=c.precision, ideal_gyro=c.gyro is None or c.gyro.is_ideal)
 
     def _law_keys(self) -> dict[str, Any]:
