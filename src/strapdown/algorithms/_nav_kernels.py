@@ -149,3 +149,133 @@ def inertial_kernel(phi, dvb, drb, period, q0, v0, p0, q_out, v_out, p_out):
         for c in range(3):
             p_out[m + 1, c] = p_out[m, c] + v_out[m, c] * period + tmp[c]
         _update(q, phi[m], q_out[m + 1])
+
+
+# ---------------------------------------------------------------------- WGS-84 navigation
+_A = 6378137.0
+_F = 1.0 / 298.257223563
+_E2 = _F * (2.0 - _F)
+_OMEGA = 7.292115e-5
+_GE = 9.7803253359
+_GK = 0.00193185265241
+_GM_RATIO = 0.00344978650684  # m = ω² a² b / GM
+
+
+@njit(cache=True, inline="always")
+def _earth(lat, hgt, out):
+    """out = (R_N + h, R_E + h, γ(L, h)): meridian and transverse radii, Somigliana gravity
+    with the second-order height correction."""
+    s2 = np.sin(lat) ** 2
+    d = 1.0 - _E2 * s2
+    out[0] = _A * (1.0 - _E2) / (d * np.sqrt(d)) + hgt
+    out[1] = _A / np.sqrt(d) + hgt
+    g0 = _GE * (1.0 + _GK * s2) / np.sqrt(d)
+    out[2] = g0 * (1.0 - 2.0 / _A * (1.0 + _F + _GM_RATIO - 2.0 * _F * s2) * hgt
+                   + 3.0 * hgt * hgt / (_A * _A))
+
+
+@njit(cache=True, inline="always")
+def _cross(a, b, out):
+    out[0] = a[1] * b[2] - a[2] * b[1]
+    out[1] = a[2] * b[0] - a[0] * b[2]
+    out[2] = a[0] * b[1] - a[1] * b[0]
+
+
+@njit(cache=True)
+def earth_nav_kernel(phi, dvb, period, lat0, lon0, h0, v0, q0, pos_out, v_out, q_out):
+    """NED navigation on the WGS-84 Earth from body increments (see
+    :mod:`strapdown.algorithms.navigation` for the equations).
+
+    pos_out (M + 1, 3) latitude, longitude (rad), height (m); v_out (M + 1, 3) NED m/s;
+    q_out (M + 1, 4) q_n_b. Row 0 is the initial state.
+    """
+    e = np.empty(3)
+    wie = np.empty(3)
+    win = np.empty(3)
+    zeta = np.empty(3)
+    x = np.empty(3)
+    an = np.empty(3)
+    t1 = np.empty(3)
+    t2 = np.empty(3)
+    t3 = np.empty(3)
+    t4 = np.empty(3)
+    wsum = np.empty(3)
+    cor = np.empty(3)
+    vm = np.empty(3)
+    qb = np.empty(4)
+    pos_out[0, 0] = lat0
+    pos_out[0, 1] = lon0
+    pos_out[0, 2] = h0
+    v_out[0, :] = v0
+    q_out[0, :] = q0
+    for m in range(phi.shape[0]):
+        p = pos_out[m]
+        v = v_out[m]
+        pp = pos_out[m - 1] if m > 0 else p
+        vp = v_out[m - 1] if m > 0 else v
+        # mid-interval position and velocity, extrapolated from the last two updates
+        lat = 1.5 * p[0] - 0.5 * pp[0]
+        hgt = 1.5 * p[2] - 0.5 * pp[2]
+        for c in range(3):
+            vm[c] = 1.5 * v[c] - 0.5 * vp[c]
+        _earth(lat, hgt, e)
+        wie[0] = _OMEGA * np.cos(lat)
+        wie[1] = 0.0
+        wie[2] = -_OMEGA * np.sin(lat)
+        win[0] = wie[0] + vm[1] / e[1]
+        win[1] = -vm[0] / e[0]
+        win[2] = wie[2] - vm[1] * np.tan(lat) / e[1]
+        for c in range(3):
+            zeta[c] = win[c] * period
+        # specific-force increment: body part rotated to n(m−1), then the frame rotation
+        q = q_out[m]
+        _rotate(q, dvb[m], x)
+        _rotate(q, phi[m], an)
+        _cross(zeta, x, t1)  # ζ × X
+        _cross(an, x, t2)  # α × X
+        _cross(zeta, t2, t3)  # ζ × (α × X)
+        _cross(zeta, t1, t4)  # ζ × (ζ × X)
+        # gravity and Coriolis at mid-interval: −(2 ω_ie + ω_en) × v = −(ω_ie + ω_in) × v
+        for c in range(3):
+            wsum[c] = wie[c] + win[c]
+        _cross(wsum, vm, cor)
+        vn = v_out[m + 1]
+        for c in range(3):
+            vn[c] = v[c] + (x[c] - 0.5 * t1[c] - t3[c] / 12.0 + t4[c] / 6.0) - cor[c] * period
+        vn[2] += e[2] * period
+        # position: trapezoid of the velocities
+        pn = pos_out[m + 1]
+        pn[2] = p[2] - 0.5 * (v[2] + vn[2]) * period
+        pn[0] = p[0] + 0.5 * (v[0] + vn[0]) * period / e[0]
+        pn[1] = p[1] + 0.5 * (v[1] + vn[1]) * period / (e[1] * np.cos(lat))
+        # attitude: q_m = q(ζ)* ⊗ q_{m−1} ⊗ q(φ)
+        _update(q, phi[m], qb)
+        for c in range(3):
+            zeta[c] = -zeta[c]
+        _left_update(zeta, qb, q_out[m + 1])
+
+
+@njit(cache=True, inline="always")
+def _left_update(zeta, q, out):
+    """out = normalise(q(ζ) ⊗ q) (exact exponential)."""
+    ang = np.sqrt(zeta[0] * zeta[0] + zeta[1] * zeta[1] + zeta[2] * zeta[2])
+    half = 0.5 * ang
+    if half < 1e-2:
+        x2 = half * half
+        s = 0.5 * (1.0 - x2 / 6.0 * (1.0 - x2 / 20.0 * (1.0 - x2 / 42.0)))
+        dw = 1.0 - x2 / 2.0 * (1.0 - x2 / 12.0 * (1.0 - x2 / 30.0 * (1.0 - x2 / 56.0)))
+    else:
+        s = np.sin(half) / ang
+        dw = np.cos(half)
+    dx = s * zeta[0]
+    dy = s * zeta[1]
+    dz = s * zeta[2]
+    w = dw * q[0] - dx * q[1] - dy * q[2] - dz * q[3]
+    x = dw * q[1] + dx * q[0] + dy * q[3] - dz * q[2]
+    y = dw * q[2] - dx * q[3] + dy * q[0] + dz * q[1]
+    z = dw * q[3] + dx * q[2] - dy * q[1] + dz * q[0]
+    inv = 1.0 / np.sqrt(w * w + x * x + y * y + z * z)
+    out[0] = w * inv
+    out[1] = x * inv
+    out[2] = y * inv
+    out[3] = z * inv

@@ -38,6 +38,9 @@ __all__ = [
     "WANG_VARIANTS",
     "CoordinatedFlight",
     "EarthField",
+    "EarthFlight",
+    "EarthSegment",
+    "EarthState",
     "Segment",
     "VehicleState",
     "WangVariant",
@@ -243,3 +246,214 @@ def wang_circle(variant: WangVariant = "speed-radius", *,
     del radius  # implied by speed and bank
     return CoordinatedFlight([Segment(60.0), Segment(190.0, math.degrees(bank))], speed=speed,
                              altitude=200.0, heading0_deg=0.0, roll_time=roll_time)
+
+
+# ------------------------------------------------------------ Earth-referenced trajectories
+@dataclass(frozen=True)
+class EarthSegment:
+    """One leg of an :class:`EarthFlight`: ``duration`` s, heading rate ``turn_rate_dps``
+    (°/s, positive clockwise seen from above) and flight-path angle ``climb_deg`` (°, nose
+    up), each reached over the flight's ramp time from the previous leg's value."""
+
+    duration: float
+    turn_rate_dps: float = 0.0
+    climb_deg: float = 0.0
+
+
+@dataclass(frozen=True)
+class EarthState:
+    """Truth of an :class:`EarthFlight` at times ``t``: latitude, longitude (rad), height
+    (m), NED velocity (m/s) and ``q_n_b`` (NED navigation frame, FRD body)."""
+
+    t: np.ndarray
+    lat: np.ndarray
+    lon: np.ndarray
+    height: np.ndarray
+    velocity: np.ndarray
+    q: np.ndarray
+
+
+def _ramp(s, tau, a, b):
+    """Value, rate, acceleration and integral of ``a → b`` by ``(1 − cos(π s/τ))/2``."""
+    s = np.asarray(s, dtype=np.float64)
+    x = np.pi * np.minimum(s, tau) / tau
+    on = s < tau
+    val = np.where(on, a + (b - a) * (1 - np.cos(x)) / 2, b)
+    rate = np.where(on, (b - a) * np.pi / (2 * tau) * np.sin(x), 0.0)
+    acc = np.where(on, (b - a) * (np.pi / tau) ** 2 / 2 * np.cos(x), 0.0)
+    ramp_int = a * np.minimum(s, tau) + (b - a) / 2 * (np.minimum(s, tau) - tau / np.pi * np.sin(x))
+    integral = ramp_int + b * np.maximum(s - tau, 0.0)
+    return val, rate, acc, integral
+
+
+class EarthFlight:
+    """A flight over the WGS-84 Earth: legs of constant speed with smooth turns and climbs.
+
+    The heading rate and the flight-path angle ramp between legs over ``ramp`` s; the body
+    banks as in a coordinated turn (``tan φ = V ψ̇ / g0``) and pitches with the flight
+    path (``θ = γ``); ``C_n_b = Rz(ψ) Ry(θ) Rx(φ)`` (NED, z-y-x). Heading, attitude,
+    velocity and their rates are closed forms; latitude, longitude and height come from
+    adaptive integration (DOP853, rtol 1e-12) of ``L̇ = v_N/(R_N + h)``,
+    ``λ̇ = v_E/((R_E + h) cos L)``, ``ḣ = −v_D``. Ideal gyro and accelerometer increments
+    are Gauss–Legendre quadratures (12 nodes per interval) of
+    ``ω_ib = ω_nb + C_b_n (ω_ie + ω_en)`` and ``f_b = C_b_n (v̇ + (2ω_ie + ω_en) × v − γ)``
+    with the normal gravity of :mod:`strapdown.truth.earth`. ``speed = 0`` is a static
+    vehicle.
+    """
+
+    def __init__(self, segments, *, lat_deg: float, lon_deg: float = 0.0, height: float = 0.0,
+                 speed: float = 0.0, heading_deg: float = 0.0, ramp: float = 5.0):
+        self.segments = tuple(segments)
+        if not self.segments:
+            raise ValueError("give at least one segment")
+        if not (math.isfinite(lat_deg) and abs(lat_deg) < 89.0):
+            raise ValueError(f"latitude must be finite and within ±89°, got {lat_deg}")
+        for i, s in enumerate(self.segments):
+            positive(s.duration, f"segment {i} duration")
+            if not abs(s.climb_deg) < 60.0:
+                raise ValueError(f"segment {i}: climb angle must be within ±60°")
+        self.lat0, self.lon0 = math.radians(lat_deg), math.radians(lon_deg)
+        self.h0 = float(height)
+        if not (math.isfinite(speed) and speed >= 0):
+            raise ValueError(f"speed must be finite and non-negative, got {speed}")
+        self.speed = float(speed)
+        self.heading0 = math.radians(heading_deg)
+        self.ramp = positive(ramp, "ramp")
+        self.starts = np.concatenate([[0.0], np.cumsum([s.duration for s in self.segments])])
+        self._sol = None
+
+    @property
+    def duration(self) -> float:
+        return float(self.starts[-1])
+
+    def _profiles(self, t):
+        """ψ, ψ̇, ψ̈, γ, γ̇, γ̈ at times ``t``."""
+        t = np.asarray(t, dtype=np.float64)
+        out = [np.zeros_like(t) for _ in range(6)]
+        psi0, r_prev, g_prev = self.heading0, 0.0, 0.0
+        seg = np.clip(np.searchsorted(self.starts, t, side="right") - 1, 0,
+                      len(self.segments) - 1)
+        for i, s in enumerate(self.segments):
+            r, g = math.radians(s.turn_rate_dps), math.radians(s.climb_deg)
+            m = seg == i
+            ds = t[m] - self.starts[i]
+            rv, ra, _, ri = _ramp(ds, self.ramp, r_prev, r)
+            gv, gr, ga, _ = _ramp(ds, self.ramp, g_prev, g)
+            for arr, val in zip(out, (psi0 + ri, rv, ra, gv, gr, ga), strict=True):
+                arr[m] = val
+            psi0 += float(_ramp(s.duration, self.ramp, r_prev, r)[3])
+            r_prev, g_prev = r, g
+        return out
+
+    def _velocity(self, t):
+        psi, dpsi, _, gam, dgam, _ = self._profiles(t)
+        v = self.speed
+        cg, sg, cp, sp_ = np.cos(gam), np.sin(gam), np.cos(psi), np.sin(psi)
+        vel = v * np.stack([cg * cp, cg * sp_, -sg], axis=-1)
+        acc = v * (dgam[..., None] * np.stack([-sg * cp, -sg * sp_, -cg], axis=-1)
+                   + dpsi[..., None] * np.stack([-cg * sp_, cg * cp, 0 * cg], axis=-1))
+        return vel, acc
+
+    def _euler(self, t):
+        """(ψ, θ, φ) and their rates."""
+        psi, dpsi, ddpsi, gam, dgam, _ = self._profiles(t)
+        k = self.speed / G
+        phi = np.arctan(k * dpsi)
+        dphi = k * ddpsi / (1.0 + (k * dpsi) ** 2)
+        return (psi, gam, phi), (dpsi, dgam, dphi)
+
+    def _solve(self):
+        if self._sol is None:
+            from scipy.integrate import solve_ivp
+
+            from strapdown.truth.earth import radii
+
+            def rhs(t, y):
+                v = self._velocity(np.array([t]))[0][0]
+                rn, re = radii(y[0], y[2])
+                return [v[0] / rn, v[1] / (re * np.cos(y[0])), -v[2]]
+
+            y0, sols = [self.lat0, self.lon0, self.h0], []
+            for i in range(len(self.segments)):
+                sol = solve_ivp(rhs, (self.starts[i], self.starts[i + 1]), y0, method="DOP853",
+                                rtol=1e-12, atol=1e-15, dense_output=True)
+                if not sol.success:  # pragma: no cover
+                    raise RuntimeError(f"trajectory integration failed: {sol.message}")
+                sols.append(sol)
+                y0 = sol.y[:, -1]
+            self._sol = sols
+        return self._sol
+
+    def _position(self, t):
+        t = np.asarray(t, dtype=np.float64)
+        sols = self._solve()
+        flat = t.ravel()
+        y = np.empty((3, flat.size))
+        seg = np.clip(np.searchsorted(self.starts, flat, side="right") - 1, 0, len(sols) - 1)
+        for i, sol in enumerate(sols):
+            m = seg == i
+            if np.any(m):
+                y[:, m] = sol.sol(flat[m])
+        return tuple(c.reshape(t.shape) for c in y)
+
+    def state(self, t) -> EarthState:
+        """Truth at times ``t`` (s, within ``[0, duration]``)."""
+        t = np.asarray(t, dtype=np.float64)
+        if t.ndim != 1 or t.size == 0 or t.min() < 0 or t.max() > self.duration * (1 + 1e-12):
+            raise ValueError(f"t must be a non-empty 1-D array within [0, {self.duration}] s")
+        lat, lon, hgt = self._position(t)
+        (psi, th, phi), _ = self._euler(t)
+        return EarthState(t, lat, lon, hgt, self._velocity(t)[0], _q_zyx(psi, th, phi))
+
+    def _body(self, t):
+        """ω_ib^b and f_b at times ``t`` (any shape)."""
+        from strapdown.truth.earth import earth_rate, gravity, transport_rate
+
+        lat, _, hgt = self._position(t)
+        (psi, th, phi), (dpsi, dth, dphi) = self._euler(t)
+        vel, acc = self._velocity(t)
+        c_nb = _dcm_zyx(psi, th, phi)
+        wie = earth_rate(lat)
+        win = wie + transport_rate(lat, hgt, vel)
+        sth, cth, sph, cph = np.sin(th), np.cos(th), np.sin(phi), np.cos(phi)
+        w_nb = np.stack([dphi - dpsi * sth, dth * cph + dpsi * sph * cth,
+                         -dth * sph + dpsi * cph * cth], axis=-1)
+        g = np.zeros_like(vel)
+        g[..., 2] = gravity(lat, hgt)
+        f_n = acc + np.cross(wie + win, vel) - g
+        w_ib = w_nb + np.einsum("...ji,...j->...i", c_nb, win)
+        return w_ib, np.einsum("...ji,...j->...i", c_nb, f_n)
+
+    def increments(self, edges):
+        """Ideal gyro (rad) and accelerometer (m/s) increments over consecutive ``edges``."""
+        from strapdown._core.validation import as_times
+
+        edges = as_times(edges, "edges", min_len=2)
+        x, w = np.polynomial.legendre.leggauss(12)
+        mid, half = 0.5 * (edges[1:] + edges[:-1]), 0.5 * (edges[1:] - edges[:-1])
+        out_g, out_a = [], []
+        for lo in range(0, mid.size, 20000):  # bounded memory
+            sl = slice(lo, lo + 20000)
+            nodes = mid[sl, None] + half[sl, None] * x[None, :]
+            wb, fb = self._body(nodes)
+            out_g.append(half[sl, None] * np.einsum("k,nkj->nj", w, wb))
+            out_a.append(half[sl, None] * np.einsum("k,nkj->nj", w, fb))
+        return np.concatenate(out_g), np.concatenate(out_a)
+
+
+def _dcm_zyx(psi, th, phi):
+    """``C_n_b = Rz(ψ) Ry(θ) Rx(φ)``, shape ``(..., 3, 3)``."""
+    cps, sps, cth, sth, cph, sph = (np.cos(psi), np.sin(psi), np.cos(th), np.sin(th),
+                                    np.cos(phi), np.sin(phi))
+    return np.stack([
+        np.stack([cps * cth, cps * sth * sph - sps * cph, cps * sth * cph + sps * sph], -1),
+        np.stack([sps * cth, sps * sth * sph + cps * cph, sps * sth * cph - cps * sph], -1),
+        np.stack([-sth, cth * sph, cth * cph], -1)], -2)
+
+
+def _q_zyx(psi, th, phi):
+    """``q_n_b = q_z(ψ) ⊗ q_y(θ) ⊗ q_x(φ)``."""
+    c1, s1, c2, s2, c3, s3 = (np.cos(psi / 2), np.sin(psi / 2), np.cos(th / 2), np.sin(th / 2),
+                              np.cos(phi / 2), np.sin(phi / 2))
+    return np.stack([c1 * c2 * c3 + s1 * s2 * s3, c1 * c2 * s3 - s1 * s2 * c3,
+                     c1 * s2 * c3 + s1 * c2 * s3, s1 * c2 * c3 - c1 * s2 * s3], axis=-1)

@@ -1,0 +1,102 @@
+"""Strapdown navigation on the WGS-84 Earth (NED): attitude, velocity and position at the
+update structure's rate with the coning and sculling corrections of
+:mod:`strapdown.algorithms.velocity` (Savage (1998b)).
+
+Per update of period ``T`` with body increments ``φ``, ``Δv_b`` (:func:`body_increments`)
+and the state at ``t_{m−1}``:
+
+* mid-interval latitude, height and velocity extrapolated from the last two updates;
+  ``ω_in = ω_ie + ω_en`` there (WGS-84 radii, :mod:`strapdown.truth.earth`),
+  ``ζ = ω_in T``;
+* specific-force increment ``X = C_{m−1} Δv_b``, ``Δv_SF = X − ½ ζ × X − (1/12) ζ × (α × X)
+  + ⅙ ζ × (ζ × X)`` (``α = C_{m−1} φ``): the navigation-frame rotation to second order,
+  consistent with the body's ``½ α × υ + ⅙ α × (α × υ)`` so that a vehicle at rest on the
+  Earth (``α = ζ``) integrates exactly;
+* ``v_m = v_{m−1} + Δv_SF + [γ − (2 ω_ie + ω_en) × v] T`` (normal gravity, Somigliana with
+  the height correction);
+* latitude, longitude and height by the trapezoid of ``v_{m−1}``, ``v_m``;
+* ``q_m = q(−ζ) ⊗ q_{m−1} ⊗ q(φ)``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from strapdown._core.validation import as_quaternions, as_vectors, finite_array
+from strapdown.algorithms import _nav_kernels
+from strapdown.algorithms.velocity import body_increments
+
+__all__ = ["NavSolution", "navigate"]
+
+
+@dataclass(frozen=True)
+class NavSolution:
+    """Navigation output, one row per update (row 0 the initial state).
+
+    ``t`` (m,) s; ``lat``, ``lon`` (m,) rad; ``height`` (m,) m; ``v`` (m, 3) NED m/s;
+    ``q`` (m, 4) ``q_n_b``.
+    """
+
+    t: NDArray[np.float64]
+    lat: NDArray[np.float64]
+    lon: NDArray[np.float64]
+    height: NDArray[np.float64]
+    v: NDArray[np.float64]
+    q: NDArray[np.float64]
+    structure: str
+    n: int
+    update_period: float
+
+
+def _initial(lat, lon, height, v0, q0):
+    lat = float(finite_array(lat, "initial latitude"))
+    if not abs(lat) < math.pi / 2:
+        raise ValueError(f"initial latitude must lie within ±90°, got {math.degrees(lat)}°")
+    lon = float(finite_array(lon, "initial longitude"))
+    height = float(finite_array(height, "initial height"))
+    v = np.zeros(3) if v0 is None else as_vectors(v0, "initial velocity")
+    q = np.array([1.0, 0.0, 0.0, 0.0]) if q0 is None else as_quaternions(q0, "initial attitude")
+    if v.shape != (3,) or q.shape != (4,):
+        raise ValueError(f"initial velocity must have shape (3,) and attitude (4,), got "
+                         f"{v.shape} and {q.shape}")
+    return lat, lon, height, v, q / np.linalg.norm(q)
+
+
+def navigate(gyro: ArrayLike, accel: ArrayLike, n: int, *, h: float, lat: float, lon: float,
+             height: float, v0: ArrayLike | None = None, q0: ArrayLike | None = None,
+             structure: str = "conventional", t0: float = 0.0,
+             sculling: bool = True) -> NavSolution:
+    """Navigate from gyro (rad) and accelerometer (m/s) increments every ``h`` seconds.
+
+    Parameters
+    ----------
+    gyro, accel : array_like of shape (k, 3)
+    n : int
+        Subsamples N of the coning and sculling corrections.
+    h : float
+        Sample interval (s).
+    lat, lon, height : float
+        Initial position (rad, rad, m).
+    v0 : array_like of shape (3,), optional
+        Initial NED velocity (m/s); zero by default.
+    q0 : array_like of shape (4,), optional
+        Initial ``q_n_b`` (NED); identity by default.
+    structure : {"conventional", "single-chain"}
+    sculling : bool
+        False drops the sculling terms (rotation compensation only).
+    """
+    lat, lon, height, v0, q0 = _initial(lat, lon, height, v0, q0)
+    b = body_increments(gyro, accel, n, h=h, structure=structure, sculling=sculling)
+    m = b.phi.shape[0]
+    pos = np.empty((m + 1, 3))
+    v = np.empty((m + 1, 3))
+    q = np.empty((m + 1, 4))
+    _nav_kernels.earth_nav_kernel(b.phi, b.dv, b.update_period, lat, lon, height, v0, q0,
+                                  pos, v, q)
+    t = float(finite_array(t0, "t0")) + np.arange(m + 1) * b.update_period
+    return NavSolution(t, pos[:, 0], pos[:, 1], pos[:, 2], v, q, structure, b.n,
+                       b.update_period)

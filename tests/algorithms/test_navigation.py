@@ -1,0 +1,98 @@
+"""WGS-84 navigation: static 2 h with ideal sensors, the Schuler oscillation of a north
+accelerometer bias against its closed form, a 10-minute flight at 100 and 200 Hz."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from strapdown.algorithms import _nav_kernels
+from strapdown.algorithms.navigation import navigate
+from strapdown.truth import earth
+from strapdown.truth.trajectory import EarthFlight, EarthSegment
+
+
+def _run(flight, rate, n=1, structure="conventional", bias=None):
+    h = 1.0 / rate
+    edges = np.arange(round(flight.duration / h) + 1) * h
+    g, a = flight.increments(edges)
+    if bias is not None:
+        a = a + np.asarray(bias) * h
+    s0 = flight.state(np.array([0.0]))
+    sol = navigate(g, a, n, h=h, lat=flight.lat0, lon=flight.lon0, height=flight.h0,
+                   q0=s0.q[0], v0=s0.velocity[0], structure=structure)
+    tr = flight.state(sol.t)
+    rn, re = earth.radii(tr.lat, tr.height)
+    dp = np.stack([(sol.lat - tr.lat) * rn, (sol.lon - tr.lon) * re * np.cos(tr.lat),
+                   tr.height - sol.height], axis=-1)
+    return sol, dp, sol.v - tr.velocity
+
+
+def test_kernel_constants_are_the_earth_model():
+    assert (_nav_kernels._A, _nav_kernels._E2, _nav_kernels._OMEGA, _nav_kernels._GE,
+            _nav_kernels._GK, _nav_kernels._GM_RATIO) == (earth.A, earth.E2, earth.OMEGA,
+                                                          earth.GE, earth.GK, earth.GM_RATIO)
+    out = np.empty(3)
+    _nav_kernels._earth(0.7, 1234.0, out)
+    rn, re = earth.radii(0.7, 1234.0)
+    assert list(out) == [rn, re, earth.gravity(0.7, 1234.0)]
+    # Somigliana: equator and pole values of WGS-84 normal gravity
+    assert earth.gravity(0.0) == pytest.approx(9.7803253359, abs=1e-10)
+    assert earth.gravity(math.pi / 2) == pytest.approx(9.8321849378, abs=1e-9)
+
+
+def test_static_two_hours_ideal_sensors_below_a_millimetre():
+    sol, dp, dv = _run(EarthFlight([EarthSegment(7200.0)], lat_deg=45.0, lon_deg=10.0,
+                                   height=100.0, heading_deg=30.0), 10.0)
+    assert sol.t[-1] == pytest.approx(7200.0)
+    assert np.max(np.abs(dp)) < 1e-3
+    assert np.max(np.abs(dv)) < 1e-6
+
+
+def test_schuler_oscillation_of_a_north_accelerometer_bias():
+    # at the equator (no Foucault rotation of the oscillation), level, heading north
+    b = 1e-4 * 9.80665
+    sol, dp, dv = _run(EarthFlight([EarthSegment(7200.0)], lat_deg=0.0), 10.0,
+                       bias=[b, 0.0, 0.0])
+    rn, _ = earth.radii(0.0, 0.0)
+    ws = math.sqrt(earth.gravity(0.0) / rn)
+    vn = dv[:, 0]
+    i = np.nonzero(np.sign(vn[1:]) != np.sign(vn[:-1]))[0]
+    crossings = sol.t[i] - vn[i] * (sol.t[i + 1] - sol.t[i]) / (vn[i + 1] - vn[i])
+    crossings = crossings[crossings > 100.0]
+    period = 2 * np.mean(np.diff(crossings))
+    assert abs(period / (2 * math.pi * math.sqrt(rn / earth.gravity(0.0))) - 1) < 0.005
+    # closed form of the north channel: δp_N = (b/ω_s²)(1 − cos ω_s t)
+    assert abs(dp[:, 0].max() / (2 * b / ws**2) - 1) < 0.01
+    closed = b / ws**2 * (1 - np.cos(ws * sol.t))
+    assert np.max(np.abs(dp[:, 0] - closed)) < 0.01 * 2 * b / ws**2
+
+
+_FLIGHT = [EarthSegment(60), EarthSegment(120, 3.0), EarthSegment(60), EarthSegment(120, 0, 5.0),
+           EarthSegment(120, -3.0, 5.0), EarthSegment(120)]
+
+
+@pytest.mark.parametrize(("structure", "n"), [("conventional", 1), ("conventional", 2)])
+def test_flight_errors_shrink_at_second_order(structure, n):
+    fl = EarthFlight(_FLIGHT, lat_deg=45.0, lon_deg=10.0, height=1000.0, speed=100.0)
+    errs = []
+    for rate in (100.0, 200.0):
+        _, dp, dv = _run(fl, rate, n, structure)
+        errs.append((np.abs(dp[:, :2]).max(), np.abs(dp[:, 2]).max(), np.abs(dv).max()))
+    ratios = np.array(errs[0]) / np.array(errs[1])
+    assert np.all((ratios > 3.4) & (ratios < 4.6)), ratios
+    assert errs[1][0] < 0.1
+
+
+def test_bad_initial_state():
+    z = np.zeros((4, 3))
+    with pytest.raises(ValueError, match="±90"):
+        navigate(z, z, 1, h=0.1, lat=2.0, lon=0.0, height=0.0)
+    with pytest.raises(ValueError, match="NaN"):
+        navigate(z, z, 1, h=0.1, lat=0.1, lon=float("nan"), height=0.0)
+    with pytest.raises(ValueError, match="NaN"):
+        navigate(z, z, 1, h=0.1, lat=0.1, lon=0.0, height=0.0, v0=[0, np.inf, 0])
+    with pytest.raises(ValueError, match="latitude"):
+        EarthFlight([EarthSegment(1.0)], lat_deg=95.0)
