@@ -179,6 +179,9 @@ _REGISTRY: dict[ConingSetName, Callable[[int], CoefficientSet]] = {
     "miller": _miller,
     "none": _none,
 }
+if tuple(_REGISTRY) != CONING_SETS:  # one list of names: the Literal
+    raise RuntimeError(f"coefficient sets {tuple(_REGISTRY)} and ConingSetName {CONING_SETS} "
+                       "disagree")
 
 
 def coefficient_set_names() -> tuple[ConingSetName, ...]:

@@ -70,6 +70,9 @@ ALGORITHMS: tuple[AlgorithmName, ...] = tuple(REGISTRY)
 #: Every update structure some family runs in.
 STRUCTURES: tuple[StructureName, ...] = tuple(dict.fromkeys(s for f in REGISTRY.values()
                                                             for s in f.structures))
+if set(STRUCTURES) != set(get_args(StructureName)):
+    raise RuntimeError(f"the families run in {STRUCTURES}, StructureName lists "
+                       f"{get_args(StructureName)}")
 #: Spec fields a spec string may set (``N`` is short for ``subsamples``).
 SPEC_KEYS = ("subsamples", "coefficients", "structure", "rk4_step", "alpha", "beta", "step",
              "exact_exp")
