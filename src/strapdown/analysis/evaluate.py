@@ -38,7 +38,7 @@ MOTIONS: tuple[MotionName, ...] = get_args(MotionName)
 MetricName = Literal["max_error_rad", "rms_error_rad", "cone_axis_drift_rad_s",
                      "predicted_drift_rad_s", "drift_rate_rad_s", "accumulated_drift_rad",
                      "update_period_s", "samples", "chain_cone_axis_drift_rad_s",
-                     "drift_points"]
+                     "drift_points", "measured_over_law", "law_status"]
 METRICS: tuple[MetricName, ...] = get_args(MetricName)
 RATE_ALGORITHMS = algorithms_taking("rate")
 

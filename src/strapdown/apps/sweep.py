@@ -33,6 +33,10 @@ Ctrl-C loses no finished case, and a changed scenario never reuses a stale
 result. When every case is done the tidy table — one row per case: ``case``,
 the grid parameters, ``algorithm``, the metrics — is written as
 ``results.csv`` and ``results.parquet`` (pyarrow; the ``parquet`` extra).
+A table with ``predicted_drift_rad_s`` also gets ``measured_over_law`` and
+``law_status`` (resolved, below float64 floor, higher order in a dominates, gyro
+errors included: :mod:`strapdown.analysis.law`), so no ratio goes out without its
+meaning.
 
 Noise is common to the algorithms of one grid point (common random numbers):
 the case seed is drawn from ``SeedSequence([seed, grid_point])``. Results do
@@ -69,6 +73,8 @@ __all__ = ["FORMATS", "Case", "Scenario", "SweepInterrupted", "SweepResult", "Ta
 # Evaluation.to_dict), defined in strapdown.analysis.evaluate.
 DEFAULT_METRICS: tuple[MetricName, ...] = ("max_error_rad", "rms_error_rad",
                                            "cone_axis_drift_rad_s", "predicted_drift_rad_s")
+#: Added to a table that has the law's drift: the ratio and its meaning (analysis.law).
+LAW_COLUMNS: tuple[MetricName, ...] = ("measured_over_law", "law_status")
 #: The table formats a finished sweep writes.
 TableFormat = Literal["csv", "parquet"]
 FORMATS: tuple[TableFormat, ...] = get_args(TableFormat)
@@ -158,6 +164,8 @@ def load_scenario(path) -> Scenario:
     metrics = doc.get("metrics", list(DEFAULT_METRICS))
     if not isinstance(metrics, list) or not metrics:
         raise ValueError(f"{path}: 'metrics' must be a non-empty list")
+    if "predicted_drift_rad_s" in metrics:  # a law in the table comes with what it means
+        metrics += [m for m in LAW_COLUMNS if m not in metrics]
     grid = doc.get("grid", {})
     for k, v in grid.items():
         if k.startswith("gyro."):
