@@ -203,3 +203,24 @@ def test_export_c_cli(tmp_path, capsys):
     assert code == 0 and "operations per update" in out.out
     assert (tmp_path / "sd_rotvec_realtime_n4.c").is_file()
     assert (tmp_path / "sd_rotvec_realtime_n4.h").is_file()
+
+
+def test_evaluate_says_what_measured_over_law_means(capsys):
+    """The README's first command: the ratio −3.84 comes with its status and a remedy."""
+    code, out = run(capsys, "evaluate", "--motion", "coning", "--half-angle-deg", "1",
+                    "--cone-rate-hz", "1", "--sample-rate-hz", "600", "--duration", "20",
+                    "--subsamples", "3", "--structure", "realtime")
+    assert code == 0
+    line = next(x for x in out.out.splitlines() if x.startswith("measured/law"))
+    assert "-3.84" in line and "(higher order in a dominates; float64 floor" in line
+    assert "--half-angle-deg" in out.out
+    code, out = run(capsys, "evaluate", "--duration", "1")  # N = 3 at 10 kHz: round-off
+    assert "(below float64 floor;" in out.out and "--precision 30" in out.out
+    code, out = run(capsys, "evaluate", "--subsamples", "2", "--sample-rate-hz", "60",
+                    "--duration", "10", "--json")
+    d = json.loads(out.out)
+    assert d["law_status"] == "resolved" and d["law_note"] is None
+    assert d["measured_over_law"] == d["cone_axis_drift_rad_s"] / d["predicted_drift_rad_s"]
+    _, out = run(capsys, "evaluate", "--motion", "spin", "--spin-rate-dps", "3600",
+                 "--duration", "0.5")
+    assert "measured/law" not in out.out  # no law, no ratio

@@ -101,7 +101,19 @@ def _text(args: argparse.Namespace, res: dict) -> list[str]:
     ]
     if res["accumulated_drift_rad"] is not None:
         lines.append(f"accum. drift  {res['accumulated_drift_rad']:.6e} rad (max 2|vec δq|)")
-    if res["predicted_drift_rad_s"] and res["cone_axis_drift_rad_s"] is not None:
-        ratio = res["cone_axis_drift_rad_s"] / res["predicted_drift_rad_s"]
-        lines.append(f"measured/law  {ratio:.6f}")
+    if res["measured_over_law"] is not None:
+        lines += _law_lines(res)
+    return lines
+
+
+def _law_lines(res: dict) -> list[str]:
+    """measured/law with its status, and what the status means here (analysis.law)."""
+    import textwrap
+
+    arith = "float64" if res["precision_digits"] is None else "mpmath"
+    floor = f"{arith} floor {res['law_floor_rad_s']:.1e} rad/s"
+    lines = [f"measured/law  {res['measured_over_law']:.6f}  ({res['law_status']}; {floor})"]
+    if res["law_note"]:
+        lines += textwrap.wrap(res["law_note"], width=92, initial_indent=" " * 14,
+                               subsequent_indent=" " * 14, break_on_hyphens=False)
     return lines
