@@ -298,54 +298,10 @@ def attitude_from_acc_mag(acc, mag=None, *, declination_deg: float = 0.0) -> np.
 
 
 def _algorithm(spec: str):
-    """Kernel arguments for a propagation algorithm spec."""
-    from strapdown.apps.compare import parse_spec
+    """Kernel arguments for a propagation algorithm spec (see AlgorithmSpec.propagation)."""
+    from strapdown.algorithms.spec import AlgorithmSpec
 
-    f = parse_spec(spec)
-    alg = f["algorithm"]
-    structure = f.get("structure", "conventional")
-    coeffs = f.get("coefficients")
-    i0 = np.zeros(0, np.int64)
-    f0 = np.zeros(0)
-    from strapdown.algorithms import rate
-
-    if alg == "rk4":
-        if f.get("rk4_step", "2td") != "2td" or structure != "conventional" or coeffs:
-            raise ValueError("the filter's rk4 is the 2td step, conventional structure")
-        return dict(is_rate=True, offsets=i0, weights=f0, pi=i0, pj=i0, pc=f0, stride=2,
-                    span=2, end_off=2, lag=1, start_c=0.0, rk4=True)
-    if alg in ("rate-single", "rate-three"):
-        if alg == "rate-single":
-            w = rate.single_period_algorithm(coeffs or "derived")
-        else:
-            w = rate.three_period_algorithm(coeffs or "derived")
-        if structure not in rate.STRUCTURES[alg]:
-            raise ValueError(f"{alg} supports {', '.join(rate.STRUCTURES[alg])}, not {structure}")
-        sliding = structure == "sliding"
-        lag = w.span if sliding else 1
-        # the sliding scheme starts with single-period steps of the same coefficient set
-        start_c = (float(rate.single_period_algorithm(coeffs or "derived").pair_coefficients[0])
-                   if sliding else 0.0)
-        return dict(is_rate=True, offsets=np.array(w.offsets, np.int64),
-                    weights=np.array([float(x) for x in w.weights]),
-                    pi=np.array([p[0] for p in w.pairs], np.int64),
-                    pj=np.array([p[1] for p in w.pairs], np.int64),
-                    pc=np.array([float(c) for c in w.pair_coefficients]),
-                    stride=1 if sliding else w.update, span=w.span, end_off=w.span, lag=lag,
-                    start_c=start_c, rk4=False)
-    if alg == "rotvec":
-        from strapdown.algorithms.coning import coefficient_set
-
-        if structure != "conventional":
-            raise ValueError("the filter runs rotvec in the conventional structure")
-        n = f.get("subsamples", 3)
-        cs = coefficient_set(coeffs or "table3", n)
-        ii, jj = np.nonzero(cs.matrix)
-        return dict(is_rate=False, offsets=np.arange(n, dtype=np.int64), weights=np.ones(n),
-                    pi=ii.astype(np.int64), pj=jj.astype(np.int64), pc=cs.matrix[ii, jj],
-                    stride=n, span=n - 1, end_off=n, lag=1, start_c=0.0, rk4=False)
-    raise ValueError(f"the filter propagates with rate-single, rate-three (sliding), rk4 or "
-                     f"rotvec:N=…, not {alg!r}")
+    return AlgorithmSpec.parse(spec).propagation()
 
 
 def _check(name, a, n):
