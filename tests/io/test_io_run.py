@@ -178,11 +178,12 @@ def test_run_split_at_gap_restarts_integration(tmp_path):
     assert set(a["segment"]) == {0.0, 1.0}
     angle = 2 * np.arctan2(a["qx"][-1], a["qw"][-1])
     assert angle == pytest.approx(0.18, rel=1e-12)
-    # without splitting, rate algorithms refuse the non-uniform record and write nothing
-    with pytest.raises(ValueError, match="between samples 10 and 11"):
+    # without splitting, rate algorithms refuse the gap and write nothing
+    with pytest.raises(ValueError, match=r"1 gap\(s\), the first of 0\.11 s before data row 11; "
+                       "rate algorithms cannot bridge a gap: pass --on-gap split"):
         run_log(tmp_path / "log.csv", tmp_path / "b.csv", kind="rate", units="rad/s",
                 algorithm="rate-single")
-    assert not (tmp_path / "b.csv").exists()
+    assert not (tmp_path / "b.csv").exists() and not (tmp_path / "b.csv.meta.json").exists()
 
 
 def test_saturation_is_reported(tmp_path, capsys):
@@ -231,7 +232,8 @@ def test_streamed_npy_reports_gaps_and_saturation(tmp_path, monkeypatch):
     np.save(tmp_path / "log.npy", np.column_stack([t, th]))
     res = run_log(tmp_path / "log.npy", tmp_path / "a.csv", kind="increment", units="rad",
                   saturation=0.01)
-    assert res["gaps"] == [101] and res["saturated"] == [151]
+    assert res["gaps"] == {"count": 1, "first_rows": [101]}
+    assert res["saturated"] == {"count": 1, "first_rows": [151]}
     with pytest.raises(ValueError, match=r"gap of 0\.011 s .* before data row 101"):
         run_log(tmp_path / "log.npy", tmp_path / "b.csv", kind="increment", units="rad",
                 on_gap="error")

@@ -170,28 +170,49 @@ def log_args(p: argparse.ArgumentParser, *, imu_help: str, required: bool,
                       help="the log holds angular increments")
     g.add_argument("--units", default=None, choices=(*RATE_UNITS, *INCREMENT_UNITS),
                    help=f"rates: {' or '.join(RATE_UNITS)}; increments: "
-                   f"{' or '.join(INCREMENT_UNITS)} (required unless the CSV header declares "
-                   "it, e.g. gx[deg/s])")
-    g.add_argument("--columns", default="t,gx,gy,gz",
-                   help="CSV columns for time and the three axes, comma-separated")
+                   f"{' or '.join(INCREMENT_UNITS)}. Required unless the file declares it: a "
+                   "CSV header (gx[deg/s]) or a known format (BROAD .mat: rad/s); a unit that "
+                   "contradicts the file's is an error")
+    g.add_argument("--columns", default=None,
+                   help="CSV columns for time and the three axes, comma-separated, e.g. "
+                   "time,wx,wy,wz (default: found in the header — time t, time, timestamp, "
+                   "time_s, t[ms] …; axes gx,gy,gz, wx,wy,wz, gyro_x,… )")
     if sample_rate:
         g.add_argument("--sample-rate-hz", type=float, default=None,
-                       help="sample rate (Hz) of a log without time stamps or a stated rate "
-                       "(.mat, HDF5)")
+                       help="the sensor's sample rate (Hz): the nominal period of a rate log's "
+                       "jittered time stamps, the increment interval of an increment log, the "
+                       "time base of a log without time stamps (default: from the stamps or "
+                       "the file's stated rate)")
 
 
-def log_check_args(p: argparse.ArgumentParser) -> None:
-    """What to do about a log's faults: ``--on-gap``, ``--gap-tolerance``, ``--saturation``."""
+def log_check_args(p: argparse.ArgumentParser, *, saturation: bool = True) -> None:
+    """What to do about a log's faults and time base: ``--on-gap``, ``--gap-tolerance``,
+    ``--saturation`` (with ``saturation``), ``--resample``, ``--accept-unit-warning``."""
+    from strapdown.algorithms.rate import JITTER_TOLERANCE
     from strapdown.apps.run import RUN_GAP_POLICIES
 
     g = p.add_argument_group("log checks")
     g.add_argument("--on-gap", choices=RUN_GAP_POLICIES, default="report",
-                   help="gaps (intervals over --gap-tolerance samples): report them, fail, or "
-                   "run each gap-free segment separately")
+                   help="gaps (intervals over --gap-tolerance sample periods): report them "
+                   "(an increment log bridges them; a rate log with a gap fails), fail, or run "
+                   "each gap-free segment on its own from the previous one's last attitude "
+                   "(a segment column is added)")
     g.add_argument("--gap-tolerance", type=float, default=1.5,
-                   help="gap threshold in median sample intervals")
-    g.add_argument("--saturation", type=float, default=None,
-                   help="sensor range in the declared unit; saturated rows are reported")
+                   help="gap threshold in sample periods (the median interval, or "
+                   "1/--sample-rate-hz)")
+    if saturation:
+        g.add_argument("--saturation", type=float, default=None,
+                       help="sensor range in the declared unit; saturated rows are reported")
+    g.add_argument("--resample", action="store_true",
+                   help="rate logs whose time stamps jitter (each within "
+                   f"{JITTER_TOLERANCE:g} period of a uniform grid): interpolate the rates onto "
+                   "the grid (cubic spline; right when the samples were taken at the stamps) "
+                   "instead of taking them to lie on it (right when the sensor samples on its "
+                   "own clock and only the stamps jitter)")
+    g.add_argument("--accept-unit-warning", action="store_true",
+                   help="run although the magnitudes suggest another unit than declared "
+                   "(e.g. a 99th-percentile rate over 200 rad/s declared as rad/s); without it "
+                   "that is an error and nothing is written")
 
 
 def progress_args(p: Options, what: str = "a progress bar") -> None:

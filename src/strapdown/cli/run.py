@@ -29,7 +29,12 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         "run", arguments=_arguments,
         help="attitude from a gyro log (CSV, .npy, .npz, .mat)",
         description="Validate a gyro log, run an algorithm over it (streamed for increment "
-        "logs) and write the attitude atomically.")
+        "logs) and write the attitude atomically: t,qw,qx,qy,qz (q_n_b) and the --angles "
+        "columns, one row per attitude update (rate-three: every 3 samples, rk4: every 2), and "
+        "beside it OUT.meta.json (input, algorithm, samples, update and sample period, jitter, "
+        "gaps, saturation, warnings, version). Jittered time stamps run on their nominal "
+        "period (or --resample); nothing is written on invalid input, on magnitudes that "
+        "suggest another unit (unless --accept-unit-warning) or on a non-finite result.")
     p.set_defaults(handler=run)
     return p
 
@@ -49,11 +54,14 @@ def _arguments(p: argparse.ArgumentParser) -> None:
     log_check_args(p)
     algorithms = log_algorithms()
     g = p.add_argument_group("algorithm")
-    g.add_argument("--algorithm", choices=algorithms, default="rotvec",
-                   help=algorithm_help(algorithms))
+    g.add_argument("--algorithm", choices=algorithms, default=None,
+                   help=algorithm_help(algorithms) + " (default: rate-three for --rates, "
+                   "rotvec for --increments)")
     g.add_argument("--structure", choices=STRUCTURES, default="conventional",
                    help=structure_help(algorithms))
-    g.add_argument("--subsamples", type=int, default=3, help="N, subsamples per update (rotvec)")
+    g.add_argument("--subsamples", type=int, default=None,
+                   help="N, subsamples per update (rotvec only, default 3; an error for the "
+                   "other algorithms)")
     g.add_argument("--coefficients", default=None,
                    help="coefficient set; " + coefficients_help(algorithms))
     o = p.add_argument_group("output")
@@ -65,22 +73,29 @@ def _arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run the log and write the attitude; gaps, saturation and warnings go to stderr."""
+    """Run the log and write the attitude and its metadata; gaps, saturation and warnings go
+    to stderr."""
     from strapdown.apps.run import run_log
 
     res = run_log(args.imu, args.out, kind=args.kind, units=args.units,
                   algorithm=args.algorithm, structure=args.structure,
                   subsamples=args.subsamples, coefficients=args.coefficients,
-                  columns=columns(args.columns), sample_rate_hz=args.sample_rate_hz,
-                  angles=args.angles, on_gap=args.on_gap, gap_tolerance=args.gap_tolerance,
-                  saturation=args.saturation, progress=progress(args))
+                  columns=None if args.columns is None else columns(args.columns),
+                  sample_rate_hz=args.sample_rate_hz, angles=args.angles, on_gap=args.on_gap,
+                  gap_tolerance=args.gap_tolerance, saturation=args.saturation,
+                  progress=progress(args), resample=args.resample,
+                  accept_unit_warning=args.accept_unit_warning)
     for w in res["warnings"]:
         say(f"warning: {w}")
-    if res["gaps"]:
+    gaps, saturated = res["gaps"], res["saturated"]
+    if gaps["count"]:
         how = "split into segments" if args.on_gap == "split" else "bridged"
-        say(f"warning: {len(res['gaps'])} gap(s) ({how}), first at data row {res['gaps'][0]}")
-    if res["saturated"]:
-        say(f"warning: {len(res['saturated'])} saturated row(s), first at data row "
-            f"{res['saturated'][0]}")
-    print(f"wrote {args.out}: {res['outputs']} attitudes from {res['samples']} samples")
+        say(f"warning: {gaps['count']} gap(s) ({how}), first at data row "
+            f"{gaps['first_rows'][0]}")
+    if saturated["count"]:
+        say(f"warning: {saturated['count']} saturated row(s), first at data row "
+            f"{saturated['first_rows'][0]}")
+    base = f"; {res['time_base']}" if res["time_base"] else ""
+    print(f"wrote {args.out}: {res['outputs']} attitudes from {res['samples']} samples "
+          f"({res['algorithm']}{base}) and {args.out}.meta.json")
     return 0

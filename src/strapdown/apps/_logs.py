@@ -1,0 +1,126 @@
+"""What the log commands (``run``, ``compare``, ``ahrs``) share: rate records per gap-free
+segment with the jitter they showed, the unit-check policy, the check that a result is
+finite, and an attitude file written together with its metadata sidecar.
+
+The sidecar ``OUT.meta.json`` and ``OUT`` are both written to temporary names beside the
+target; only when both are complete is a stale sidecar removed, ``OUT`` renamed into place
+and then — last — the sidecar. A failure before that leaves neither (nor any temporary
+file); an ``OUT`` without its sidecar can only be the trace of a run killed between the two
+renames, and a sidecar always describes the ``OUT`` beside it.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from strapdown.algorithms.rate import UNIFORM_TOLERANCE, RateRecord, check_rate_record
+from strapdown.io.files import atomic_path
+from strapdown.io.readers import ImuLog, UnitAction
+
+__all__ = ["JitterSummary", "PairedOutput", "check_finite", "output_with_sidecar",
+           "rate_records", "sidecar_path", "unit_action"]
+
+
+def unit_action(accept_unit_warning: bool) -> UnitAction:
+    """Magnitudes that suggest another unit than declared: an error unless accepted."""
+    return "warn" if accept_unit_warning else "error"
+
+
+@dataclass(frozen=True)
+class JitterSummary:
+    """The time base the rate algorithms ran on, over every segment."""
+
+    period: float  # nominal sample period (s) of the longest segment
+    jitter: float  # largest deviation of a stamp from its segment's grid, in periods
+    resampled: bool
+    segments: int
+
+    def describe(self) -> str:
+        """``nominal period 0.001 s (1000 Hz), jitter ±0.5 % of it`` (+ resampled)."""
+        text = f"nominal period {self.period:.6g} s ({1 / self.period:.6g} Hz), "
+        text += (f"jitter ±{100 * self.jitter:.2g} % of it" if self.jitter > UNIFORM_TOLERANCE
+                 else "uniform time stamps")
+        return text + (", resampled onto the uniform grid" if self.resampled else "")
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"sample_period_s": self.period, "jitter_periods": self.jitter,
+                "resampled": self.resampled, "segments": self.segments}
+
+
+def rate_records(path: Path, log: ImuLog, *, split: bool, min_samples: int,
+                 resample: bool) -> tuple[list[RateRecord], JitterSummary]:
+    """The log's rates on a uniform grid, one record per gap-free segment (``split``) or
+    one for the whole log, and their time base.
+
+    Gaps in an unsplit log are an error (rate algorithms cannot bridge one); so are
+    stamps beyond the jitter tolerance (:func:`strapdown.algorithms.rate.check_rate_record`,
+    which also takes the nominal period from ``--sample-rate-hz``).
+    """
+    if log.gaps and not split:
+        r = log.gaps[0]
+        gap = float(log.t[r - 1] - log.t[r - 2])
+        raise ValueError(f"{path}: {len(log.gaps)} gap(s), the first of {gap:.6g} s before data "
+                         f"row {r}; rate algorithms cannot bridge a gap: pass --on-gap split "
+                         "(each gap-free segment on its own) or --on-gap error")
+    cuts = log.segments() if split else [slice(0, log.t.size)]
+    recs = []
+    for k, c in enumerate(cuts):
+        try:
+            recs.append(check_rate_record(log.t[c], log.data[c], min_samples=min_samples,
+                                          td=log.nominal_period, resample=resample))
+        except ValueError as exc:
+            where = f" segment {k} (data rows {c.start + 1}-{c.stop})" if split else ""
+            raise ValueError(f"{path}:{where} {exc}") from None
+    longest = max(recs, key=lambda r: r.t.size)
+    return recs, JitterSummary(longest.td, max(r.jitter for r in recs),
+                               any(r.resampled for r in recs), len(recs))
+
+
+def check_finite(what: str, t: NDArray[np.float64], *arrays: NDArray[np.float64]) -> None:
+    """Raise when a result is NaN or infinite anywhere, naming the first row and time."""
+    for a in arrays:
+        bad = ~np.all(np.isfinite(a.reshape(a.shape[0], -1)), axis=1)
+        if np.any(bad):
+            i = int(np.argmax(bad))
+            raise ValueError(f"{what} is NaN or infinite from output row {i + 1} (t = "
+                             f"{float(t[i]):.6g} s); nothing written")
+
+
+def sidecar_path(out: Path) -> Path:
+    """``OUT.meta.json`` beside ``OUT``."""
+    return out.with_name(out.name + ".meta.json")
+
+
+@dataclass
+class PairedOutput:
+    """Where to write the attitude (a temporary path) and the metadata to put beside it."""
+
+    path: Path
+    meta: dict[str, Any] = field(default_factory=dict)
+
+
+@contextlib.contextmanager
+def output_with_sidecar(out: Path) -> Iterator[PairedOutput]:
+    """Write ``out`` and ``OUT.meta.json`` together (see the module docstring).
+
+    Yields a :class:`PairedOutput`: write the attitude to its ``path`` and fill its
+    ``meta``; both land when the block ends without an exception, the sidecar last.
+    """
+    meta_path = sidecar_path(out)
+    with atomic_path(meta_path) as meta_tmp, atomic_path(out) as tmp:
+        paired = PairedOutput(Path(tmp))
+        yield paired
+        if not paired.meta:
+            raise RuntimeError("output_with_sidecar: no metadata was given")
+        meta_tmp.write_text(json.dumps(paired.meta, indent=2, ensure_ascii=False) + "\n",
+                            encoding="utf-8")
+        meta_path.unlink(missing_ok=True)  # a stale sidecar must not describe the new OUT
+    # atomic_path(out) renamed the attitude first, atomic_path(meta_path) the sidecar last
