@@ -39,6 +39,7 @@ from __future__ import annotations
 import itertools
 from dataclasses import dataclass
 from fractions import Fraction
+from typing import Literal, get_args
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -53,6 +54,7 @@ __all__ = [
     "NAV_STRUCTURES",
     "BodyIncrements",
     "InertialSolution",
+    "NavStructure",
     "ScullingLaw",
     "body_increments",
     "integrate_inertial",
@@ -63,7 +65,8 @@ __all__ = [
 ]
 
 #: Update structures of the velocity/position algorithms.
-NAV_STRUCTURES = ("conventional", "single-chain")
+NavStructure = Literal["conventional", "single-chain"]
+NAV_STRUCTURES: tuple[NavStructure, ...] = get_args(NavStructure)
 
 
 @dataclass(frozen=True)
@@ -87,7 +90,7 @@ def _n(n: int) -> int:
     return n
 
 
-def _structure(structure: str) -> str:
+def _structure(structure: object) -> NavStructure:
     if structure not in NAV_STRUCTURES:
         raise ValueError(f"unknown velocity structure {structure!r}; choose one of "
                          f"{', '.join(NAV_STRUCTURES)}")
@@ -145,7 +148,7 @@ class BodyIncrements:
     dr: NDArray[np.float64]
     h: float
     update_period: float
-    structure: str
+    structure: NavStructure
     n: int
 
 
@@ -159,7 +162,8 @@ def _inputs(gyro: ArrayLike, accel: ArrayLike) -> tuple[NDArray[np.float64], NDA
 
 
 def body_increments(gyro: ArrayLike, accel: ArrayLike, n: int, *, h: float,
-                    structure: str = "conventional", sculling: bool = True) -> BodyIncrements:
+                    structure: NavStructure = "conventional", sculling: bool = True
+                    ) -> BodyIncrements:
     """Coning, sculling and scrolling compensated body increments (module docstring).
 
     Parameters
@@ -211,7 +215,7 @@ class InertialSolution:
     q: NDArray[np.float64]
     v: NDArray[np.float64]
     p: NDArray[np.float64]
-    structure: str
+    structure: NavStructure
     n: int
     h: float
     update_period: float
@@ -230,7 +234,7 @@ def _state(q0, v0, p0):
 
 
 def integrate_inertial(gyro: ArrayLike, accel: ArrayLike, n: int, *, h: float,
-                       structure: str = "conventional", t0: float = 0.0,
+                       structure: NavStructure = "conventional", t0: float = 0.0,
                        q0: ArrayLike | None = None, v0: ArrayLike | None = None,
                        p0: ArrayLike | None = None, sculling: bool = True) -> InertialSolution:
     """Strapdown integration in a non-rotating frame without gravity (sculling studies).
@@ -267,7 +271,7 @@ class MpInertialSolution:
 
 
 def integrate_inertial_mp(motion, n: int, *, h: float, samples: int, digits: int,
-                          structure: str = "conventional") -> MpInertialSolution:
+                          structure: NavStructure = "conventional") -> MpInertialSolution:
     """:func:`integrate_inertial` in arbitrary precision on a closed-form sculling motion.
 
     Exact increments (:meth:`~strapdown.truth.sculling.ScullingMotion.increment_mp`,
