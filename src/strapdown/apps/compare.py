@@ -6,13 +6,24 @@ structure=sliding``, ``rk4:rk4_step=td-interp``, ``miller:step=0.01``. The keys
 are :class:`~strapdown.analysis.evaluate.EvaluationConfig` fields (``N`` is short for
 ``subsamples``); an unknown key is an error that lists the known ones.
 
-On a motion, errors are against the exact truth. On a log there is no truth
-unless one is given (a ``t,qw,qx,qy,qz`` file); otherwise the first spec is
-the reference and the others are reported relative to it. Either way the
-reference is interpolated (slerp) to each algorithm's output times and only
-times inside the reference's span are compared.
+On a motion, errors are against the exact truth. On a log with a truth file
+(``t,qw,qx,qy,qz``: CSV, ``.npy`` of n × 5 or ``.npz``), the truth is slerped to
+each algorithm's output times (only times inside its span; the table says whether
+the outputs fall on truth samples or between them).
 
-Output (a directory): ``error_vs_time.png``, ``summary.csv`` and ``summary.md``.
+On a log without truth nothing is interpolated: two algorithms are compared only at
+the output times they share (within 10⁻⁶ of a sample interval). The **reference** is
+the algorithm with the finest output grid — it shares every output time of the
+others when their grids are subsets of it — and among equally fine grids the one
+closest to the others (smallest sum of its largest differences from each), then the
+first in spec-text order. The choice depends on the specs, never on their order.
+Interpolating a coarser reference instead would report its interpolation error
+(4e-6 rad on the tutorial's log, 3 ms grid) as the algorithms' difference.
+``differences.md``/``.csv`` give the largest difference of every pair at their
+common times, whichever the reference.
+
+Output (a directory): ``error_vs_time.png``, ``summary.csv`` and ``summary.md``
+(plus ``differences.csv``/``.md`` without truth).
 """
 
 from __future__ import annotations
@@ -30,8 +41,9 @@ from numpy.typing import NDArray
 from strapdown._core.kinds import InputKind
 from strapdown.algorithms.spec import AlgorithmSpec, parse_spec
 from strapdown.analysis.evaluate import EvaluationConfig, evaluate
+from strapdown.io.files import write_text
 from strapdown.io.readers import GyroUnit
-from strapdown.io.report import Report
+from strapdown.io.report import Curve, Report, plot_error_curves
 
 __all__ = ["AlgorithmRun", "compare_log", "compare_motion"]
 
@@ -43,6 +55,15 @@ class AlgorithmRun:
     t: NDArray[np.float64]
     angle: NDArray[np.float64]
     summary: dict[str, object]
+    #: The error history's sawtooth period in outputs (interleaved chains; 1: smooth).
+    period: int = 1
+
+
+#: Times within this fraction of a sample interval are the same output time.
+TIME_TOLERANCE = 1e-6
+#: Differences from the reference up to this angle (rad, ~50 ε) are round-off.
+ROUNDOFF_ANGLE = 1e-14
+_ITSELF = "itself (the reference)"
 
 
 def _summary_row(label, t, angle, update_period, extra=None) -> dict:
@@ -60,47 +81,113 @@ def compare_motion(base: EvaluationConfig, specs: Iterable[str], out: str | os.P
     specs = list(specs)
     if not specs:
         raise ValueError("give at least one algorithm spec")
-    runs = []
+    runs, notes = [], []
     for spec in specs:
         cfg = dataclasses.replace(base, **parse_spec(spec))
         ev = evaluate(cfg)
         d = ev.to_dict()
-        ratio = (d["cone_axis_drift_rad_s"] / d["predicted_drift_rad_s"]
-                 if d["predicted_drift_rad_s"] and d["cone_axis_drift_rad_s"] is not None
-                 else None)
         runs.append(AlgorithmRun(spec, ev.t, ev.angle, _summary_row(
             spec, ev.t, ev.angle, ev.update_period,
             {"cone_axis_drift_rad_s": d["cone_axis_drift_rad_s"],
-             "predicted_drift_rad_s": d["predicted_drift_rad_s"], "measured_over_law": ratio})))
+             "predicted_drift_rad_s": d["predicted_drift_rad_s"],
+             "measured_over_law": d["measured_over_law"], "law_status": d["law_status"]}),
+            _chains(ev.chain)))
+        if d["law_note"]:
+            where = " (--precision: strapdown evaluate)" if "--precision" in d["law_note"] else ""
+            notes.append(f"- {spec}: {d['law_status']} — {d['law_note']}{where}")
     title = (f"{base.motion}, half angle {base.half_angle_deg}°, cone {base.cone_rate_hz} Hz, "
              f"spin {base.spin_rate_dps} °/s, {base.sample_rate_hz:g} Hz gyro")
-    _write(out, runs, title, "error against the exact truth", progress)
+    _write(out, runs, title, "error against the exact truth", progress,
+           ylabel="attitude error angle (rad)", notes=notes)
     return runs
+
+
+def _chains(chain: NDArray[np.int_]) -> int:
+    """Number of interleaved chains of a solution (its error's sawtooth period)."""
+    return int(np.unique(chain).size) if chain.size else 1
+
+
+_TRUTH_COLUMNS = ("t", "qw", "qx", "qy", "qz")
+_TRUTH_FORMATS = "CSV with columns t,qw,qx,qy,qz, .npy of shape (n, 5) or .npz with t,qw,qx,qy,qz"
 
 
 def _read_truth(path: str | os.PathLike[str]
                 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """``(t, q)`` of a truth file (:data:`_TRUTH_FORMATS`), checked by :func:`_check_truth`."""
     path = Path(path)
-    if path.suffix.lower() == ".npz":
-        with np.load(path) as z:
-            missing = [k for k in ("t", "qw", "qx", "qy", "qz") if k not in z]
-            if missing:
-                raise ValueError(f"{path}: truth needs arrays t, qw, qx, qy, qz; missing "
-                                 f"{missing}")
-            return np.asarray(z["t"], float), np.column_stack(
-                [np.asarray(z[k], float) for k in ("qw", "qx", "qy", "qz")])
-    with open(path, encoding="utf-8") as f:
-        header = [c.strip() for c in f.readline().split(",")]
-    missing = [k for k in ("t", "qw", "qx", "qy", "qz") if k not in header]
-    if missing:
-        raise ValueError(f"{path}: truth needs columns t, qw, qx, qy, qz; missing {missing}")
-    arr = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
-    cols = [header.index(k) for k in ("t", "qw", "qx", "qy", "qz")]
-    return arr[:, cols[0]], arr[:, cols[1:]]
+    if not path.is_file():
+        raise ValueError(f"{path}: no such truth file")
+    suffix = path.suffix.lower()
+    if suffix == ".npz":
+        t, q = _read_truth_npz(path)
+    elif suffix == ".npy":
+        try:
+            arr = np.load(path, allow_pickle=False)
+        except ValueError as exc:
+            raise ValueError(f"{path}: not a readable .npy array ({exc})") from None
+        if arr.ndim != 2 or arr.shape[1] != 5 or arr.dtype.kind not in "fiu":
+            raise ValueError(f"{path}: a .npy truth is a numeric array of shape (n, 5) with "
+                             f"columns t, qw, qx, qy, qz; got {arr.dtype} {arr.shape}")
+        t, q = arr[:, 0].astype(float), arr[:, 1:].astype(float)
+    elif suffix in (".csv", ".txt"):
+        from strapdown.io.readers import csv_columns, time_scale
+
+        try:
+            raw, units, _ = csv_columns(path, _TRUTH_COLUMNS)
+        except UnicodeDecodeError:
+            raise ValueError(f"{path}: not a text CSV; truth must be {_TRUTH_FORMATS}") from None
+        t = raw[:, 0] * time_scale(path, "t", units)
+        q = raw[:, 1:5]
+    else:
+        raise ValueError(f"{path}: unknown truth format {path.suffix!r}; truth must be "
+                         f"{_TRUTH_FORMATS}")
+    _check_truth(path, t, q)
+    return t, q
+
+
+def _read_truth_npz(path: Path) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    try:
+        z = np.load(path, allow_pickle=False)
+    except (ValueError, OSError) as exc:
+        raise ValueError(f"{path}: not a readable .npz archive ({exc})") from None
+    with z:
+        missing = [k for k in _TRUTH_COLUMNS if k not in z]
+        if missing:
+            raise ValueError(f"{path}: truth needs arrays t, qw, qx, qy, qz; missing {missing}")
+        cols = [np.asarray(z[k], dtype=float).ravel() for k in _TRUTH_COLUMNS]
+    if len({c.size for c in cols}) != 1:
+        raise ValueError(f"{path}: arrays t, qw, qx, qy, qz differ in length "
+                         f"{[c.size for c in cols]}")
+    return cols[0], np.column_stack(cols[1:])
+
+
+def _check_truth(path: Path, t: NDArray[np.float64], q: NDArray[np.float64]) -> None:
+    """Two or more rows, finite, strictly increasing times, unit quaternions (±1e-3)."""
+    if t.size < 2:
+        raise ValueError(f"{path}: truth needs at least two rows, has {t.size}")
+    bad = np.flatnonzero(~(np.isfinite(t) & np.all(np.isfinite(q), axis=1)))
+    if bad.size:
+        raise ValueError(f"{path}: NaN or infinity in truth row {bad[0] + 1}")
+    step = np.flatnonzero(np.diff(t) <= 0)
+    if step.size:
+        raise ValueError(f"{path}: truth times must increase strictly; row {step[0] + 2} "
+                         f"(t = {t[step[0] + 1]!r}) does not")
+    norm = np.linalg.norm(q, axis=1)
+    off = np.flatnonzero(np.abs(norm - 1.0) > 1e-3)
+    if off.size:
+        raise ValueError(f"{path}: truth row {off[0] + 1} is not a unit quaternion (norm "
+                         f"{norm[off[0]]:.6g}); columns are qw, qx, qy, qz (scalar first)")
+
+
+def _inside(t: NDArray[np.float64], t_ref: NDArray[np.float64], tol: float
+            ) -> tuple[NDArray[np.bool_], NDArray[np.float64]]:
+    """Which ``t`` lie in ``t_ref``'s span (``tol`` s of slack), and ``t`` clipped into it."""
+    inside = (t >= t_ref[0] - tol) & (t <= t_ref[-1] + tol)
+    return inside, np.clip(t[inside], t_ref[0], t_ref[-1])
 
 
 def _errors_against(t_ref: NDArray[np.float64], q_ref: NDArray[np.float64],
-                    t: NDArray[np.float64], q: NDArray[np.float64]
+                    t: NDArray[np.float64], q: NDArray[np.float64], tol: float = 0.0
                     ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Angle between ``q`` and the reference slerped to ``t`` (inside the reference span)."""
     from scipy.spatial.transform import Slerp
@@ -108,11 +195,23 @@ def _errors_against(t_ref: NDArray[np.float64], q_ref: NDArray[np.float64],
     from strapdown.rotation.error import attitude_error_angle
     from strapdown.rotation.interop import quat_from_scipy, scipy_from_quat
 
-    inside = (t >= t_ref[0]) & (t <= t_ref[-1])
+    inside, tc = _inside(t, t_ref, tol)
     if not np.any(inside):
         return t[:0], np.empty(0)
-    ref = quat_from_scipy(Slerp(t_ref, scipy_from_quat(q_ref))(t[inside]))
+    ref = quat_from_scipy(Slerp(t_ref, scipy_from_quat(q_ref))(tc))
     return t[inside], attitude_error_angle(q[inside], ref)
+
+
+def _common_times(ta: NDArray[np.float64], tb: NDArray[np.float64], tol: float
+                  ) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
+    """Indices ``(ia, ib)`` with ``|ta[ia] − tb[ib]| <= tol``: the output times both share."""
+    if ta.size == 0 or tb.size == 0:
+        return np.empty(0, np.intp), np.empty(0, np.intp)
+    j = np.searchsorted(ta, tb).clip(0, ta.size - 1)
+    left = (j - 1).clip(0)
+    j = np.where(np.abs(ta[left] - tb) < np.abs(ta[j] - tb), left, j)  # the nearest ta
+    ok = np.abs(ta[j] - tb) <= tol
+    return j[ok].astype(np.intp), np.flatnonzero(ok).astype(np.intp)
 
 
 def _run_on_log(log, fields, q0):
@@ -137,56 +236,143 @@ def compare_log(imu: str | os.PathLike[str], specs: Iterable[str], out: str | os
         raise ValueError("give at least one algorithm spec")
     fields = [parse_spec(s) for s in specs]
     log = read_imu(imu, kind=kind, units=units, columns=columns, sample_rate_hz=sample_rate_hz)
-    q0 = None
-    if truth is not None:
-        t_ref, q_ref = _read_truth(truth)
-        from scipy.spatial.transform import Slerp
-
-        from strapdown.rotation.interop import quat_from_scipy, scipy_from_quat
-
-        t_start = float(log.t[0]) - (log.h if kind == "increment" else 0.0)
-        if not t_ref[0] <= t_start <= t_ref[-1]:
-            raise ValueError(f"{truth}: covers t = {t_ref[0]}…{t_ref[-1]} s, not the log's start "
-                             f"{t_start} s")
-        q0 = quat_from_scipy(Slerp(t_ref, scipy_from_quat(q_ref))([t_start]))[0]
-    sols = [_run_on_log(log, f, q0) for f in fields]
+    tol = TIME_TOLERANCE * log.h
+    title = f"{Path(imu).name}: {log.t.size} {kind} samples at {1 / log.h:g} Hz"
     if truth is None:
-        t_ref, q_ref = sols[0][0].t, sols[0][0].q
-        what = f"difference from {specs[0]} (no truth given)"
-    else:
-        what = f"error against {Path(truth).name}"
+        sols = [_run_on_log(log, f, None) for f in fields]
+        runs, what, ylabel, pairs = _against_reference(specs, sols, tol)
+        _write(out, runs, title, what, progress, ylabel=ylabel, pairs=pairs)
+        return runs
+    t_ref, q_ref = _read_truth(truth)
+    q0 = _truth_start(truth, t_ref, q_ref, log, tol)
+    sols = [_run_on_log(log, f, q0) for f in fields]
+    name = Path(truth).name
     runs = []
     for spec, (sol, period) in zip(specs, sols, strict=True):
-        t, ang = _errors_against(t_ref, q_ref, sol.t, sol.q)
-        runs.append(AlgorithmRun(spec, t, ang, _summary_row(spec, t, ang, period)))
-    _write(out, runs, f"{Path(imu).name}: {log.t.size} {kind} samples at {1 / log.h:g} Hz",
-           what, progress)
+        t, ang = _errors_against(t_ref, q_ref, sol.t, sol.q, tol)
+        on = _common_times(t_ref, t, tol)[1].size
+        where = "at its samples" if on == t.size else f"slerped, {t.size - on} outputs between"
+        runs.append(AlgorithmRun(spec, t, ang, _summary_row(
+            spec, t, ang, period, {"compared_outputs": int(t.size),
+                                   "reference": f"{name} ({where})"}), _chains(sol.chain)))
+    _write(out, runs, title, f"error against {name}", progress,
+           ylabel=f"attitude error against {name} (rad)")
     return runs
 
 
-def _write(out, runs, title, what, progress) -> None:
+def _truth_start(truth, t_ref: NDArray[np.float64], q_ref: NDArray[np.float64], log,
+                 tol: float) -> NDArray[np.float64]:
+    """The truth's attitude at the log's start; a start outside the truth's span by no more
+    than ``tol`` (round-off of ``t[0] − h``: −4.3e-19 s against 0) counts as its end."""
+    from scipy.spatial.transform import Slerp
+
+    from strapdown.rotation.interop import quat_from_scipy, scipy_from_quat
+
+    t_start = float(log.t[0]) - (log.h if log.kind == "increment" else 0.0)
+    if not t_ref[0] - tol <= t_start <= t_ref[-1] + tol:
+        raise ValueError(f"{truth}: covers t = {t_ref[0]!r}…{t_ref[-1]!r} s, not the log's "
+                         f"start {t_start!r} s")
+    t_start = min(max(t_start, float(t_ref[0])), float(t_ref[-1]))
+    return quat_from_scipy(Slerp(t_ref, scipy_from_quat(q_ref))([t_start]))[0]
+
+
+def _pair_differences(labels, sols, tol: float) -> dict[tuple[int, int], tuple]:
+    """Every pair's difference angle at the output times both share: ``(ia, ib, angle)``.
+
+    The angle is taken in spec-text order (the smaller label's attitude first), so that
+    not even its round-off depends on the order the specs were given in.
+    """
+    from strapdown.rotation.error import attitude_error_angle
+
+    out = {}
+    for a in range(len(sols)):
+        for b in range(a + 1, len(sols)):
+            sa, sb = sols[a][0], sols[b][0]
+            ia, ib = _common_times(sa.t, sb.t, tol)
+            qa, qb = sa.q[ia], sb.q[ib]
+            out[a, b] = (ia, ib, attitude_error_angle(qa, qb) if labels[a] <= labels[b]
+                         else attitude_error_angle(qb, qa))
+    return out
+
+
+def _choose_reference(labels, periods, pairs) -> int:
+    """Finest output grid; then closest to the others; then spec text (module docstring)."""
+    def largest(a, b):
+        ang = pairs[min(a, b), max(a, b)][2]
+        return float(ang.max()) if ang.size else math.inf
+
+    finest = min(periods)
+    candidates = [i for i, p in enumerate(periods) if math.isclose(p, finest, rel_tol=1e-9)]
+    return min(candidates, key=lambda i: (
+        math.fsum(largest(i, j) for j in range(len(labels)) if j != i), labels[i]))
+
+
+def _against_reference(specs, sols, tol):
+    """Runs as differences from the chosen reference at common output times (no truth)."""
+    pairs = _pair_differences(specs, sols, tol)
+    ref = _choose_reference(specs, [p for _, p in sols], pairs)
+    runs = []
+    for i, (spec, (sol, period)) in enumerate(zip(specs, sols, strict=True)):
+        if i == ref:
+            t, ang, chains = sol.t, np.zeros(sol.t.size), 1
+            note = _ITSELF
+        else:
+            ia, ib, ang = pairs[min(i, ref), max(i, ref)]
+            mine, theirs = (ia, ib) if i < ref else (ib, ia)
+            t = sol.t[mine]
+            pattern = sol.chain[mine] * (sols[ref][0].chains + 1) + sols[ref][0].chain[theirs]
+            chains = int(np.unique(pattern).size) if pattern.size else 1
+            note = f"{specs[ref]} at {t.size} of {sol.t.size} outputs"
+        runs.append(AlgorithmRun(spec, t, ang, _summary_row(
+            spec, t, ang, period, {"compared_outputs": int(t.size), "reference": note}),
+            chains))
+    what = (f"no truth given: difference from {specs[ref]} (the reference: finest output "
+            "grid),\nat common output times only (no interpolation)")
+    return runs, what, f"difference from {specs[ref]} (rad)", (specs, pairs)
+
+
+def _write(out, runs, title, what, progress, *, ylabel: str, notes=(), pairs=None) -> None:
     rep = Report.begin(out, progress)
     fig, ax = rep.plt.subplots(figsize=(8, 4.5))
-    for r in runs:
-        if r.angle.size and np.any(r.angle > 0):
-            ax.semilogy(r.t, np.where(r.angle > 0, r.angle, np.nan), lw=0.8, label=r.label)
-        else:
-            ax.plot([], [], label=f"{r.label} (identically zero)")
-    ax.set_xlabel("t (s)")
-    ax.set_ylabel("attitude error angle (rad)")
+    plot_error_curves(ax, [_curve(r, pairs is not None) for r in runs], ylabel=ylabel)
     ax.set_title(f"{title}\n{what}", fontsize=9)
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
     rep.figure("error_vs_time.png", fig)
     header = list(runs[0].summary)
     for r in runs[1:]:
         header += [k for k in r.summary if k not in header]
+    md = rep.table("summary", header, [[_cell(r.summary.get(k)) for k in header] for r in runs])
+    if notes:
+        write_text(rep.out / "summary.md", md + "\n" + "\n".join(notes) + "\n")
+    files = "summary.md, summary.csv, error_vs_time.png"
+    if pairs is not None:
+        labels, diffs = pairs
+        rows = [[a, *(("0" if a == b else _cell(_largest(diffs, i, j)))
+                      for j, b in enumerate(labels))] for i, a in enumerate(labels)]
+        rep.table("differences", ["largest difference (rad) at common output times", *labels],
+                  rows)
+        files += ", differences.md, differences.csv"
+    rep.say(f"wrote {rep.out}/{files} ({what.replace(chr(10), ' ')})")
 
-    def cell(v):
-        if v is None or (isinstance(v, float) and math.isnan(v)):
-            return ""
-        return f"{v:.6e}" if isinstance(v, float) else v
 
-    rows = [[cell(r.summary.get(k)) for k in header] for r in runs]
-    rep.table("summary", header, rows)
-    rep.say(f"wrote {rep.out}/summary.md, summary.csv, error_vs_time.png ({what})")
+def _curve(r: AlgorithmRun, vs_reference: bool) -> Curve:
+    """The figure's curve of a run; without truth the reference itself and differences at
+    round-off level are listed in the legend, not drawn (they would stretch the axis)."""
+    hidden = ""
+    if vs_reference and r.summary.get("reference") == _ITSELF:
+        hidden = "the reference"
+    elif vs_reference and r.angle.size == 0:
+        hidden = "no output time in common with the reference"
+    elif vs_reference and float(r.angle.max()) <= ROUNDOFF_ANGLE:
+        hidden = f"equal to the reference to round-off, at most {float(r.angle.max()):.1e} rad"
+    return Curve(r.t, r.angle, r.label, r.period, hidden)
+
+
+def _largest(diffs, i: int, j: int) -> float:
+    ang = diffs[min(i, j), max(i, j)][2]
+    return float(ang.max()) if ang.size else math.nan
+
+
+def _cell(v):
+    if v is None or (isinstance(v, float) and math.isnan(v)):
+        return ""
+    return f"{v:.6e}" if isinstance(v, float) else v

@@ -1,13 +1,18 @@
-"""Shared output for reproduction reports: tables as CSV + Markdown, figures as PNG."""
+"""Shared output for reproduction reports: tables as CSV + Markdown, figures as PNG, and
+the drawing of error histories that sawtooth (:func:`plot_error_curves`)."""
 
 from __future__ import annotations
 
 import os
 import time
-from collections.abc import Callable
+import warnings
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from strapdown.io.files import csv_table, markdown_table, save_figure, write_text
 
@@ -114,3 +119,113 @@ class Report:
         """Write ``report.md`` (atomically); returns its path."""
         return write_text(self.out / "report.md", text)
 
+
+
+# -- figures of error histories ---------------------------------------------------------------
+
+
+def running_envelope(y: ArrayLike, period: int) -> tuple[NDArray[np.float64],
+                                                          NDArray[np.float64]]:
+    """Running minimum and maximum of ``y`` over centred windows of ``period`` points.
+
+    The envelope of an N-periodic sawtooth (N interleaved chains, each smooth): over any
+    ``period`` consecutive outputs every chain appears once, so the window's extremes are
+    the lowest and the highest chain there. NaN points are ignored (a window of NaN only
+    gives NaN). ``period`` 1 returns ``y`` twice.
+    """
+    y = np.asarray(y, dtype=np.float64)
+    if not isinstance(period, (int, np.integer)) or period < 1:
+        raise ValueError(f"period must be a positive integer, got {period!r}")
+    if period == 1 or y.size == 0:
+        return y.copy(), y.copy()
+    lo_pad, hi_pad = (period - 1) // 2, period // 2
+    padded = np.concatenate([np.full(lo_pad, np.nan), y, np.full(hi_pad, np.nan)])
+    windows = np.lib.stride_tricks.sliding_window_view(padded, period)
+    with np.errstate(all="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN windows give NaN
+        return np.nanmin(windows, axis=1), np.nanmax(windows, axis=1)
+
+
+def log_ylim(arrays: Iterable[ArrayLike], *, percentile: float = 1.0
+             ) -> tuple[float, float] | None:
+    """Log-axis limits that show the curves, not their outliers.
+
+    The lower limit is the ``percentile``-th percentile of all positive finite values
+    (so a start-up point at 1e-24 under curves at 1e-9 does not stretch the axis over 15
+    decades), divided by 2; the upper limit is the largest value times 2. None when no
+    value is positive.
+    """
+    vals = [np.asarray(a, dtype=np.float64).ravel() for a in arrays]
+    allv = np.concatenate(vals) if vals else np.empty(0)
+    pos = allv[np.isfinite(allv) & (allv > 0)]
+    if pos.size == 0:
+        return None
+    return float(np.percentile(pos, percentile)) / 2.0, float(pos.max()) * 2.0
+
+
+@dataclass(frozen=True)
+class Curve:
+    """One error history to draw: ``y`` against ``t``, a sawtooth of ``period`` outputs.
+
+    ``hidden``: a reason not to draw the curve (e.g. "the reference", "round-off only");
+    it then appears in the legend only, with that reason.
+    """
+
+    t: NDArray[np.float64]
+    y: NDArray[np.float64]
+    label: str
+    period: int = 1
+    hidden: str = ""
+
+
+_MARKERS = ("o", "s", "^", "D", "v", "P", "X", "*")
+
+
+def plot_error_curves(ax: Any, curves: Sequence[Curve], *, ylabel: str) -> None:
+    """Draw error histories on a log axis so that every curve stays visible.
+
+    A sawtooth curve (``period`` > 1: interleaved chains) is drawn as a band between
+    its running minimum and maximum over one period (:func:`running_envelope`) with its
+    maximum as a line; a smooth curve as a line with a few markers (offset per curve, so
+    curves on top of each other stay distinguishable). Bands go below lines, wider
+    bands below narrower ones; the y-limits come from :func:`log_ylim` over the drawn
+    curves. Hidden curves and curves that are identically zero get a legend entry saying
+    so. The legend, below the axes, says what each entry is.
+    """
+    bands, lines, drawn, handles = [], [], [], []
+    for i, c in enumerate(curves):
+        y = np.where(np.asarray(c.y) > 0, c.y, np.nan)
+        if c.hidden or not np.any(np.isfinite(y)):
+            handles.append((i, ax.plot([], [], ls="none", color="0.4")[0],
+                            f"{c.label} ({c.hidden or 'identically zero'}, not drawn)"))
+            continue
+        drawn.append(c.y)
+        if c.period > 1:
+            lo, hi = running_envelope(y, c.period)
+            width = float(np.nanmedian(np.log10(hi) - np.log10(lo)))
+            bands.append((width, i, c, lo, hi))
+        else:
+            lines.append((i, c, y))
+    color = {i: f"C{i % 10}" for i in range(len(curves))}
+    bands.sort(key=lambda b: -b[0])  # widest first, at the bottom
+    for z, (_, i, c, lo, hi) in enumerate(bands):
+        band = ax.fill_between(c.t, lo, hi, color=color[i], alpha=0.22, lw=0, zorder=1 + z)
+        (line,) = ax.plot(c.t, hi, color=color[i], lw=0.9, zorder=1 + z)
+        handles.append((i, (band, line), f"{c.label}: range over {c.period} outputs (band) "
+                        f"and its max (line); {c.period} interleaved chains"))
+    for k, (i, c, y) in enumerate(lines):
+        every = max(1, y.size // 12)
+        (line,) = ax.plot(c.t, y, color=color[i], lw=1.2, marker=_MARKERS[k % len(_MARKERS)],
+                          ms=4, markevery=(k * every // max(1, len(lines)), every),
+                          zorder=10 + k)
+        handles.append((i, line, c.label))
+    ax.set_yscale("log")
+    lim = log_ylim(drawn)
+    if lim is not None:
+        ax.set_ylim(*lim)
+    ax.set_xlabel("t (s)")
+    ax.set_ylabel(ylabel)
+    ax.grid(True, which="both", alpha=0.3)
+    handles.sort(key=lambda h: h[0])  # the legend in the curves' order
+    ax.legend([h[1] for h in handles], [h[2] for h in handles], fontsize=7,
+              loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=1, frameon=False)
