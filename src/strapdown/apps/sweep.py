@@ -316,20 +316,7 @@ def sweep(scenario: str | os.PathLike[str] | Scenario, out: str | os.PathLike[st
         cases are saved.
     """
     kind, address = _parse_scheduler(scheduler)
-    formats = tuple(formats)
-    bad = [f for f in formats if f not in FORMATS]
-    if bad or not formats:
-        raise ValueError(f"formats must be a non-empty subset of csv, parquet; got {formats}")
-    if "parquet" in formats:
-        try:
-            import pyarrow  # noqa: F401
-        except ImportError:
-            raise ValueError("Parquet output needs pyarrow: pip install 'strapdown[parquet]', "
-                             "or ask for --format csv") from None
-    if workers is not None and workers < 1:
-        raise ValueError(f"workers must be at least 1, got {workers}")
-    if max_cases is not None and max_cases < 0:
-        raise ValueError(f"max_cases must be non-negative, got {max_cases}")
+    formats = _check_options(tuple(formats), workers, max_cases)
     scn = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
     say = log or (lambda _m: None)
     out = Path(out)
@@ -371,6 +358,24 @@ def sweep(scenario: str | os.PathLike[str] | Scenario, out: str | os.PathLike[st
     csv_path = _write_csv(out / "results.csv", rows)
     pq = _write_parquet(out / "results.parquet", rows) if "parquet" in formats else None
     return SweepResult(len(all_cases), skipped, len(pending), csv_path, pq)
+
+
+def _check_options(formats: tuple, workers: int | None, max_cases: int | None) -> tuple:
+    """The table formats, once the sweep's options are checked (ValueError naming one)."""
+    bad = [f for f in formats if f not in FORMATS]
+    if bad or not formats:
+        raise ValueError(f"formats must be a non-empty subset of csv, parquet; got {formats}")
+    if "parquet" in formats:
+        try:
+            import pyarrow  # noqa: F401
+        except ImportError:
+            raise ValueError("Parquet output needs pyarrow: pip install 'strapdown[parquet]', "
+                             "or ask for --format csv") from None
+    if workers is not None and workers < 1:
+        raise ValueError(f"workers must be at least 1, got {workers}")
+    if max_cases is not None and max_cases < 0:
+        raise ValueError(f"max_cases must be non-negative, got {max_cases}")
+    return formats
 
 
 def _run_local(pending, workers, finish, bar) -> None:
