@@ -212,7 +212,8 @@ def plot_error_curves(ax: Any, curves: Sequence[Curve], *, ylabel: str) -> None:
         band = ax.fill_between(c.t, lo, hi, color=color[i], alpha=0.22, lw=0, zorder=1 + z)
         (line,) = ax.plot(c.t, hi, color=color[i], lw=0.9, zorder=1 + z)
         handles.append((i, (band, line), f"{c.label}: range over {c.period} outputs (band) "
-                        f"and its max (line); {c.period} interleaved chains"))
+                        f"and its max (line), a sawtooth of period {c.period} (interleaved "
+                        "chains)"))
     for k, (i, c, y) in enumerate(lines):
         every = max(1, y.size // 12)
         (line,) = ax.plot(c.t, y, color=color[i], lw=1.2, marker=_MARKERS[k % len(_MARKERS)],
