@@ -182,19 +182,32 @@ def test_bad_input_names_the_problem():
 
 
 def test_broad_metric_on_known_errors():
+    """BROAD's metric as published: a heading offset is an error; removing it is an option
+    reported in separate keys."""
     rng = np.random.default_rng(2)
     q = rng.standard_normal((500, 4))
     q /= np.linalg.norm(q, axis=1, keepdims=True)
     mv = np.ones(500, bool)
     assert broad_errors(q, q, mv)["total_deg"] == pytest.approx(0.0, abs=1e-6)
-    yaw = np.array([math.cos(0.3), 0, 0, math.sin(0.3)])  # 34.4° heading offset: removed
+    yaw = np.array([math.cos(0.3), 0, 0, math.sin(0.3)])  # 34.4° heading offset: counted
     e = broad_errors(quat_multiply(yaw, q), q, mv)
-    assert e["total_deg"] == pytest.approx(0.0, abs=1e-6)
-    assert e["heading_offset_deg"] == pytest.approx(math.degrees(0.6), abs=1e-9)
+    assert e["total_deg"] == pytest.approx(math.degrees(0.6), rel=1e-9)
+    assert e["heading_deg"] == pytest.approx(math.degrees(0.6), rel=1e-9)
+    assert e["inclination_deg"] == pytest.approx(0.0, abs=1e-6)
+    assert "heading_offset_deg" not in e
+    off = broad_errors(quat_multiply(yaw, q), q, mv, remove_heading_offset=True)
+    assert {k: off[k] for k in e} == e  # BROAD's keys unchanged
+    assert off["heading_offset_deg"] == pytest.approx(math.degrees(0.6), rel=1e-9)
+    assert off["total_offset_removed_deg"] == pytest.approx(0.0, abs=1e-6)
     tilt = np.array([math.cos(0.01), math.sin(0.01), 0, 0])  # 1.146° about east
-    e = broad_errors(quat_multiply(tilt, q), q, mv)
+    ref = q.copy()
+    ref[:100] = np.nan  # markers lost: skipped
+    e = broad_errors(quat_multiply(tilt, q), ref, mv)
     assert e["inclination_deg"] == pytest.approx(math.degrees(0.02), rel=1e-9)
     assert e["heading_deg"] == pytest.approx(0.0, abs=1e-9)
+    assert e["samples"] == 400
+    with pytest.raises(ValueError, match="one row per sample"):
+        broad_errors(q[1:], q, mv)
 
 
 @pytest.mark.skipif(BROAD is None, reason="BROAD data not found (set STRAPDOWN_BROAD)")
@@ -236,24 +249,30 @@ def test_cli_ahrs_csv_roundtrip_and_degraded_mode(tmp_path, capsys):
     assert meta["frame"] == "ENU" and meta["heading_observed"] is True
     # no magnetometer columns: heading not observed, said so
     np.savetxt(tmp_path / "nomag.csv", np.column_stack([t, w, acc]), delimiter=",",
-               header="t,gx,gy,gz,ax,ay,az", comments="")
+               header="t,gx[rad/s],gy[rad/s],gz[rad/s],ax[m/s2],ay[m/s2],az[m/s2]",
+               comments="")  # units from the header
     assert main(["ahrs", "--imu", str(tmp_path / "nomag.csv"), "--out",
                  str(tmp_path / "n.npz"), "--frame", "NED"]) == 0
     assert "heading is not observed" in capsys.readouterr().err
     meta = json.loads((tmp_path / "n.npz.meta.json").read_text())
     assert meta["heading_observed"] is False and meta["frame"] == "NED"
-    # gyro in deg/s declared as rad/s: a unit warning (fast spin: 600 °/s → 600 "rad/s")
+    # gyro in deg/s declared as rad/s: an error, nothing written (fast spin: 600 °/s → 600
+    # "rad/s"); more such cases in tests/cli/test_wrong_answers.py
     spin = np.column_stack([t, np.tile([0, 0, 600.0], (t.size, 1)), np.tile(G_UP, (t.size, 1))])
     np.savetxt(tmp_path / "deg.csv", spin, delimiter=",", header="t,gx,gy,gz,ax,ay,az",
                comments="")
-    main(["ahrs", "--imu", str(tmp_path / "deg.csv"), "--out", str(tmp_path / "d.csv")])
-    assert "more likely in deg/s" in capsys.readouterr().err
+    with pytest.raises(SystemExit) as exc:
+        main(["ahrs", "--imu", str(tmp_path / "deg.csv"), "--gyro-units", "rad/s",
+              "--acc-units", "m/s2", "--out", str(tmp_path / "d.csv")])
+    assert exc.value.code == 2 and "more likely in deg/s" in capsys.readouterr().err
+    assert not (tmp_path / "d.csv").exists()
     bad = np.column_stack([t, w, acc])
     bad[11, 4] = np.nan
     np.savetxt(tmp_path / "nan.csv", bad, delimiter=",", header="t,gx,gy,gz,ax,ay,az",
                comments="")
     with pytest.raises(SystemExit) as exc:
-        main(["ahrs", "--imu", str(tmp_path / "nan.csv"), "--out", str(tmp_path / "x.csv")])
+        main(["ahrs", "--imu", str(tmp_path / "nan.csv"), "--gyro-units", "rad/s",
+              "--acc-units", "m/s2", "--out", str(tmp_path / "x.csv")])
     assert exc.value.code == 2
     assert "NaN or infinity in the accelerometer at data row 12" in capsys.readouterr().err
     assert not (tmp_path / "x.csv").exists()

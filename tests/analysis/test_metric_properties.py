@@ -82,10 +82,13 @@ def test_broad_errors_ignore_the_signs(case, heading_offset):
     q_est, q_ref, movement, se, sr = case
     if heading_offset:  # a phasor mean of ~0 leaves the offset undefined (any answer is right)
         assume(_resultant(q_est, q_ref, movement) > 1e-6)
-    a = broad_errors(q_est, q_ref, movement, heading_offset=heading_offset)
-    b = broad_errors(_flip(q_est, se), _flip(q_ref, sr), movement, heading_offset=heading_offset)
-    assert a["samples"] == b["samples"]
-    for k in ("total_deg", "heading_deg", "inclination_deg"):
-        assert abs(a[k] - b[k]) <= 1e-12, k
-    d_off = (a["heading_offset_deg"] - b["heading_offset_deg"] + 180.0) % 360.0 - 180.0
-    assert abs(d_off) <= 1e-12
+    a = broad_errors(q_est, q_ref, movement, remove_heading_offset=heading_offset)
+    b = broad_errors(_flip(q_est, se), _flip(q_ref, sr), movement,
+                     remove_heading_offset=heading_offset)
+    assert a.keys() == b.keys() and a["samples"] == b["samples"]
+    for k in ("total_deg", "heading_deg", "inclination_deg", "total_offset_removed_deg",
+              "heading_offset_removed_deg", "inclination_offset_removed_deg"):
+        assert abs(a.get(k, 0.0) - b.get(k, 0.0)) <= 1e-12, k
+    if heading_offset:
+        d_off = (a["heading_offset_deg"] - b["heading_offset_deg"] + 180.0) % 360.0 - 180.0
+        assert abs(d_off) <= 1e-12

@@ -15,9 +15,10 @@ Runs, on every BROAD trial (``*.mat``) in a directory and in the same run:
 
 The peers are an optional extra (``pip install 'strapdown[bench]'``); a
 missing peer is reported as missing, never silently dropped. Metrics are
-BROAD's (:func:`strapdown.analysis.broad.broad_errors`): total, heading and
-inclination RMSE over movement phases, in degrees. Writes ``errors.csv``,
-``errors.md``, ``summary.md`` (means per filter) and ``errors.png``.
+BROAD's as published (:func:`strapdown.analysis.broad.broad_errors`, no heading
+offset removed): total, heading and inclination RMSE over movement phases, in
+degrees. Writes ``errors.csv``, ``errors.md``, ``summary.md`` (means per filter)
+and ``errors.png``.
 """
 
 from __future__ import annotations
@@ -143,9 +144,10 @@ def benchmark(directory: str | os.PathLike[str], out: str | os.PathLike[str], *,
                          f"{e['inclination_deg']:.3f}", f"{sec:.2f}"])
     md = ["# AHRS on BROAD: strapdown's EKF against VQF and Fusion\n\n",
           "Data: BROAD (Laidig, Caruso, Cereatti & Seel, Data 6(7), 2021; CC BY 4.0). Metrics: "
-          "RMSE over movement phases of the error quaternion q_imu ⊗ q_opt*, constant "
-          "heading offset removed; total, heading (twist about the vertical) and inclination "
-          f"(the rest), degrees. Our propagation: {algorithm}.\n\n"]
+          "BROAD's as published (broad_utils.calculateRMSE): RMSE over movement phases of the "
+          "error quaternion q_imu ⊗ q_opt*, no heading offset removed (the optical reference "
+          "is in the magnetic ENU frame); total, heading (rotation about the vertical) and "
+          f"inclination (the rest), degrees. Our propagation: {algorithm}.\n\n"]
     if missing:
         md.append("Not run: " + "; ".join(f"{k} — {v}" for k, v in missing.items()) + "\n\n")
     md.append(rep.table("errors", ["trial", "filter", "total (°)", "heading (°)",
