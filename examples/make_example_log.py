@@ -16,9 +16,14 @@ in the other layouts the documentation uses:
     a 20 s, 200 Hz gyro + accelerometer + magnetometer recording for ``strapdown ahrs``:
     ``t,gx,gy,gz,ax,ay,az,mx,my,mz`` in deg/s, g and µT, of a slowly coning and spinning
     body at rest otherwise (gravity and a magnetic field only, in ENU).
+``--nav FILE.csv``
+    a 2 min, 100 Hz gyro + accelerometer log for ``strapdown nav``: rates and specific
+    force (``t,gx[deg/s],gy[deg/s],gz[deg/s],ax[m/s^2],ay[m/s^2],az[m/s^2]``, body FRD) of
+    a flight over the WGS-84 Earth from 45° N, 7° E, 300 m, heading 30° at 60 m/s (VN VE VD
+    = 51.96 30 0), level: 30 s straight, a 3 °/s turn, a 4° climb.
 
 Usage: ``python examples/make_example_log.py [--increments flight.npy] [--plain log.csv]
-[--gaps gappy.csv] [--imu9 recording.csv]``.
+[--gaps gappy.csv] [--imu9 recording.csv] [--nav nav-log.csv]``.
 """
 
 from __future__ import annotations
@@ -86,12 +91,25 @@ def imu9(path: str) -> None:
          "t,gx,gy,gz,ax,ay,az,mx,my,mz")
 
 
+def nav_log(path: str) -> None:
+    """An Earth flight's ideal rates and specific force at 100 Hz (see the module docstring)."""
+    from strapdown.truth.trajectory import EarthFlight, EarthSegment
+
+    fl = EarthFlight([EarthSegment(30.0), EarthSegment(45.0, 3.0), EarthSegment(45.0, 0.0, 4.0)],
+                     lat_deg=45.0, lon_deg=7.0, height=300.0, speed=60.0, heading_deg=30.0)
+    t = np.arange(12001) / 100.0
+    w, f = fl.sensed(t)
+    _csv(path, np.column_stack([t, np.degrees(w), f]),
+         "t,gx[deg/s],gy[deg/s],gz[deg/s],ax[m/s^2],ay[m/s^2],az[m/s^2]", fmt="%.17g")
+
+
 def main(argv: list[str] | None = None) -> None:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0], allow_abbrev=False)
     p.add_argument("--increments", metavar="FILE.npy", help="also write exact increments")
     p.add_argument("--plain", metavar="FILE.csv", help="also write rates under time,wx,wy,wz")
     p.add_argument("--gaps", metavar="FILE.csv", help="also write the rate log with two gaps")
     p.add_argument("--imu9", metavar="FILE.csv", help="also write a 9-axis AHRS recording")
+    p.add_argument("--nav", metavar="FILE.csv", help="also write an Earth flight's nav log")
     a = p.parse_args(argv)
     m = _motion()
     gyro_and_truth(m)
@@ -103,6 +121,9 @@ def main(argv: list[str] | None = None) -> None:
     if a.imu9:
         imu9(a.imu9)
         written.append(a.imu9)
+    if a.nav:
+        nav_log(a.nav)
+        written.append(a.nav)
     print("wrote " + ", ".join(written))
 
 

@@ -3,6 +3,7 @@ accelerometer bias against its closed form, a 10-minute flight at 100 and 200 Hz
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -96,3 +97,24 @@ def test_bad_initial_state():
         navigate(z, z, 1, h=0.1, lat=0.1, lon=0.0, height=0.0, v0=[0, np.inf, 0])
     with pytest.raises(ValueError, match="latitude"):
         EarthFlight([EarthSegment(1.0)], lat_deg=95.0)
+
+
+@pytest.mark.parametrize(("structure", "n"), [("conventional", 1), ("conventional", 3),
+                                              ("single-chain", 1), ("single-chain", 4)])
+def test_stream_equals_navigate_bit_for_bit(structure, n):
+    from strapdown.algorithms.navigation import NavStream
+
+    fl = EarthFlight([EarthSegment(3.0), EarthSegment(3.0, 5.0, 4.0)], lat_deg=40.0,
+                     speed=90.0, ramp=2.0)
+    h = 0.01
+    g, a = fl.increments(np.arange(601) * h)
+    s0 = fl.state(np.array([0.0]))
+    kw = {"h": h, "lat": fl.lat0, "lon": fl.lon0, "height": fl.h0, "q0": s0.q[0],
+          "v0": s0.velocity[0], "structure": structure, "t0": 2.5}
+    sol = navigate(g, a, n, **kw)
+    stream = NavStream(n, **kw)
+    cuts = [0, 0, 1, 2, 3, 50, 51, 200, 333, 598, 600]  # chunks shorter than N, empty ones too
+    parts = [stream.feed(g[i:j], a[i:j]) for i, j in itertools.pairwise(cuts)]
+    for name in ("t", "lat", "lon", "height", "v", "q"):
+        got = np.concatenate([getattr(p, name) for p in parts])
+        assert np.array_equal(got, getattr(sol, name)[1:]), name

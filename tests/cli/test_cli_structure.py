@@ -15,7 +15,7 @@ from strapdown import cli
 from strapdown.cli import build_parser, main
 
 #: The subcommands README.md and docs/tutorial.md document (the contract scripts rely on).
-DOCUMENTED = ("evaluate", "coefficients", "export-c", "run", "compare", "sweep", "ahrs",
+DOCUMENTED = ("evaluate", "coefficients", "export-c", "run", "nav", "compare", "sweep", "ahrs",
               "benchmark-ahrs", "reproduce", "bench")
 HEAVY = ("numpy", "scipy", "numba", "sympy", "matplotlib")
 

@@ -189,6 +189,21 @@ def earth_nav_kernel(phi, dvb, period, lat0, lon0, h0, v0, q0, pos_out, v_out, q
     pos_out (M + 1, 3) latitude, longitude (rad), height (m); v_out (M + 1, 3) NED m/s;
     q_out (M + 1, 4) q_n_b. Row 0 is the initial state.
     """
+    pos_out[0, 0] = lat0
+    pos_out[0, 1] = lon0
+    pos_out[0, 2] = h0
+    v_out[0, :] = v0
+    q_out[0, :] = q0
+    earth_nav_chunk_kernel(phi, dvb, period, pos_out[0], v_out[0], False, pos_out, v_out, q_out)
+
+
+@njit(cache=True)
+def earth_nav_chunk_kernel(phi, dvb, period, pos_prev, v_prev, has_prev, pos_out, v_out,
+                           q_out):
+    """:func:`earth_nav_kernel` continuing a run: rows 0 of the outputs hold the state the
+    chunk starts from (filled by the caller), ``pos_prev``, ``v_prev`` the state one update
+    before it, used for the mid-interval extrapolation of the first update when
+    ``has_prev`` (a run's first update has none and takes its own state)."""
     e = np.empty(3)
     wie = np.empty(3)
     win = np.empty(3)
@@ -203,16 +218,18 @@ def earth_nav_kernel(phi, dvb, period, lat0, lon0, h0, v0, q0, pos_out, v_out, q
     cor = np.empty(3)
     vm = np.empty(3)
     qb = np.empty(4)
-    pos_out[0, 0] = lat0
-    pos_out[0, 1] = lon0
-    pos_out[0, 2] = h0
-    v_out[0, :] = v0
-    q_out[0, :] = q0
     for m in range(phi.shape[0]):
         p = pos_out[m]
         v = v_out[m]
-        pp = pos_out[m - 1] if m > 0 else p
-        vp = v_out[m - 1] if m > 0 else v
+        if m > 0:
+            pp = pos_out[m - 1]
+            vp = v_out[m - 1]
+        elif has_prev:
+            pp = pos_prev
+            vp = v_prev
+        else:
+            pp = p
+            vp = v
         # mid-interval position and velocity, extrapolated from the last two updates
         lat = 1.5 * p[0] - 0.5 * pp[0]
         hgt = 1.5 * p[2] - 0.5 * pp[2]

@@ -16,6 +16,9 @@ and the state at ``t_{m−1}``:
   the height correction);
 * latitude, longitude and height by the trapezoid of ``v_{m−1}``, ``v_m``;
 * ``q_m = q(−ζ) ⊗ q_{m−1} ⊗ q(φ)``.
+
+:class:`NavStream` runs the same update over a log fed in chunks, equal to
+:func:`navigate` bit for bit whatever the chunking.
 """
 
 from __future__ import annotations
@@ -30,7 +33,7 @@ from strapdown._core.validation import as_quaternions, as_vectors, finite_array
 from strapdown.algorithms import _nav_kernels
 from strapdown.algorithms.velocity import NavStructure, body_increments
 
-__all__ = ["NavSolution", "navigate"]
+__all__ = ["NavSolution", "NavStream", "navigate"]
 
 
 @dataclass(frozen=True)
@@ -100,3 +103,87 @@ def navigate(gyro: ArrayLike, accel: ArrayLike, n: int, *, h: float, lat: float,
     t = float(finite_array(t0, "t0")) + np.arange(m + 1) * b.update_period
     return NavSolution(t, pos[:, 0], pos[:, 1], pos[:, 2], v, q, structure, b.n,
                        b.update_period)
+
+
+_Z3 = np.zeros((0, 3))
+
+
+class NavStream:
+    """:func:`navigate` over increments fed in chunks (a log streamed from a file).
+
+    Each :meth:`feed` returns the updates its samples complete, one row per update (no
+    initial row), bit for bit the rows :func:`navigate` gives on the whole record: the
+    conventional structure keeps a tail of fewer than N samples for the next chunk and
+    the previous update's samples for the running two-sample sculling; the single chain
+    keeps the last N − 1 samples (its pair terms reach N − 1 back); the navigation state
+    keeps the update before the last for the mid-interval extrapolation.
+
+    Parameters are those of :func:`navigate`; ``t0`` is the time of the initial state.
+    """
+
+    def __init__(self, n: int, *, h: float, lat: float, lon: float, height: float,
+                 v0: ArrayLike | None = None, q0: ArrayLike | None = None,
+                 structure: str = "conventional", t0: float = 0.0, sculling: bool = True):
+        from strapdown._core.validation import positive
+        from strapdown.algorithms.velocity import _n, _structure
+
+        lat, lon, height, v, q = _initial(lat, lon, height, v0, q0)
+        self.n, self.h = _n(n), positive(h, "h (sample interval)")
+        self.structure, self.sculling = _structure(structure), bool(sculling)
+        self.update_period = self.n * self.h if structure == "conventional" else self.h
+        self._pos = np.array([lat, lon, height])
+        self._v, self._q = v, q
+        self._prev: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None
+        self._ctx = (_Z3, _Z3)  # samples before the chunk the next one needs as context
+        self._pending = (_Z3, _Z3)  # conventional: samples short of a whole update
+        self._t0 = float(finite_array(t0, "t0"))
+        self._updates = 0
+
+    def _body(self, g: NDArray[np.float64], a: NDArray[np.float64]):
+        """Body increments of the new samples, computed with their context."""
+        n = self.n
+        g = np.concatenate([self._pending[0], g])
+        a = np.concatenate([self._pending[1], a])
+        if self.structure == "conventional":
+            m = g.shape[0] // n
+            self._pending = (g[m * n:], a[m * n:])
+            g, a = g[: m * n], a[: m * n]
+            keep = n
+        else:
+            keep = n - 1
+        if g.shape[0] == 0:
+            return None
+        cg, ca = self._ctx
+        b = body_increments(np.concatenate([cg, g]), np.concatenate([ca, a]), n, h=self.h,
+                            structure=self.structure, sculling=self.sculling)
+        skip = cg.shape[0] // (n if self.structure == "conventional" else 1)
+        both_g, both_a = np.concatenate([cg, g]), np.concatenate([ca, a])
+        start = max(both_g.shape[0] - keep, 0)
+        self._ctx = (both_g[start:], both_a[start:]) if keep else (_Z3, _Z3)
+        return b.phi[skip:], b.dv[skip:]
+
+    def feed(self, gyro: ArrayLike, accel: ArrayLike) -> NavSolution:
+        """Advance by gyro (rad) and accelerometer (m/s) increments ``(k, 3)``; returns the
+        updates completed (possibly none)."""
+        from strapdown.algorithms.velocity import _inputs
+
+        g, a = _inputs(gyro, accel) if np.size(gyro) else (_Z3, _Z3)
+        body = self._body(g, a)
+        m = 0 if body is None else body[0].shape[0]
+        pos = np.empty((m + 1, 3))
+        v = np.empty((m + 1, 3))
+        q = np.empty((m + 1, 4))
+        pos[0], v[0], q[0] = self._pos, self._v, self._q
+        if m:
+            assert body is not None
+            prev = self._prev if self._prev is not None else (pos[0], v[0])
+            _nav_kernels.earth_nav_chunk_kernel(np.ascontiguousarray(body[0]),
+                                                np.ascontiguousarray(body[1]),
+                                                self.update_period, prev[0], prev[1],
+                                                self._prev is not None, pos, v, q)
+            self._prev = (pos[-2].copy(), v[-2].copy())
+            self._pos, self._v, self._q = pos[-1].copy(), v[-1].copy(), q[-1].copy()
+        t = self._t0 + (self._updates + 1 + np.arange(m)) * self.update_period
+        self._updates += m
+        return NavSolution(t, pos[1:, 0], pos[1:, 1], pos[1:, 2], v[1:], q[1:],
+                           self.structure, self.n, self.update_period)

@@ -1,7 +1,7 @@
 """The ``strapdown`` command line: one module per subcommand.
 
 Each subcommand module (:mod:`.evaluate`, :mod:`.coefficients`, :mod:`.export_c`,
-:mod:`.run`, :mod:`.compare`, :mod:`.sweep`, :mod:`.ahrs`, :mod:`.benchmark_ahrs`,
+:mod:`.run`, :mod:`.nav`, :mod:`.compare`, :mod:`.sweep`, :mod:`.ahrs`, :mod:`.benchmark_ahrs`,
 :mod:`.reproduce`, :mod:`.bench`) has ``add_parser(subparsers)`` and ``run(args) -> int``;
 argument groups several of them share are in :mod:`._common`. Choice lists come from the
 registries (algorithm families, coefficient sets, designer forms, reproductions), imported
@@ -29,6 +29,7 @@ from strapdown.cli import (
     compare,
     evaluate,
     export_c,
+    nav,
     reproduce,
     run,
     sweep,
@@ -38,7 +39,7 @@ from strapdown.cli._common import CommandParser, HelpFormatter, Parser, say
 __all__ = ["COMMANDS", "EXIT_STATUS", "build_parser", "main"]
 
 #: The subcommand modules, in the order ``strapdown --help`` lists them.
-COMMANDS = (evaluate, coefficients, export_c, run, compare, sweep, ahrs, benchmark_ahrs,
+COMMANDS = (evaluate, coefficients, export_c, run, nav, compare, sweep, ahrs, benchmark_ahrs,
             reproduce, bench)
 
 EXIT_OK, EXIT_USAGE, EXIT_IO, EXIT_INTERRUPTED, EXIT_PIPE = 0, 2, 74, sweep.INTERRUPTED, 141

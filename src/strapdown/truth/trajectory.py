@@ -424,6 +424,11 @@ class EarthFlight:
         w_ib = w_nb + np.einsum("...ji,...j->...i", c_nb, win)
         return w_ib, np.einsum("...ji,...j->...i", c_nb, f_n)
 
+    def sensed(self, t) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Ideal gyro rate ``ω_ib`` (rad/s) and specific force ``f_b`` (m/s²) in the body
+        frame at times ``t`` (any shape, s): the samples of a rate log."""
+        return self._body(np.asarray(t, dtype=np.float64))
+
     def increments(self, edges):
         """Ideal gyro (rad) and accelerometer (m/s) increments over consecutive ``edges``."""
         from strapdown._core.validation import as_times

@@ -1,0 +1,376 @@
+"""``strapdown nav``: position, velocity and attitude on the WGS-84 Earth from a gyro and
+accelerometer log, streamed, written atomically.
+
+A nav log holds a time column and gyro and accelerometer axes: a CSV with a header
+(``t,gx,gy,gz,ax,ay,az``, the names and units of :mod:`strapdown.io.readers`, e.g.
+``gx[deg/s]``, ``ax[m/s^2]``), an ``.npz`` or HDF5 file with arrays ``t``, ``gyro`` and
+``accel``, or a ``.mat`` file (PSINS ``[wm vm t]`` increments, BROAD ``imu_gyr``/``imu_acc``
+rates). Rates (gyro rad/s or deg/s, accelerometer m/s² or g) are turned into increments
+over the sample intervals by the cubic through four neighbouring samples
+(:func:`increments_from_rates`); increment logs (``--increments``) hold rad (or deg) and
+m/s. The gyro is read by :func:`strapdown.io.read_imu` (its columns, units, row checks and
+gap detection); the accelerometer by the small reader here, on the same helpers
+(:func:`~strapdown.io.readers.csv_columns`, :func:`~strapdown.io.readers.check_rows`),
+because ``read_imu`` reads gyro axes only.
+
+Validation: a log without accelerometer columns, a unit the file contradicts, NaN or
+infinity (row named), gaps and non-uniform stamps are errors; so is an accelerometer whose
+median norm suggests the other unit (≈ 1 declared as m/s²: the log is in g — gravity alone
+gives 9.8 m/s² — or ≈ 9.8 declared as g) unless ``accept_unit_warning``. The initial state
+(latitude within ±90°, everything finite) is checked before the log is read.
+
+Output: one row per update, ``t,lat_deg,lon_deg,height_m,vn,ve,vd,qw,qx,qy,qz`` (NED,
+``q_n_b``), CSV or ``.npz``; the navigation runs in chunks through
+:class:`strapdown.algorithms.navigation.NavStream` (bit for bit the one-shot
+:func:`~strapdown.algorithms.navigation.navigate`), each written as it completes to a
+temporary file renamed over the target at the end, so nothing is written on failure.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import sys
+import warnings
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Literal, get_args
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from tqdm import tqdm
+
+from strapdown._core.kinds import InputKind
+from strapdown.algorithms.navigation import NavStream
+from strapdown.algorithms.rate import JITTER_TOLERANCE
+from strapdown.io import read_imu
+from strapdown.io.files import atomic_path
+from strapdown.io.readers import (
+    ACC_COLUMNS,
+    GYRO_COLUMNS,
+    GyroUnit,
+    UnitAction,
+    UnitWarning,
+    canonical_unit,
+    check_rows,
+    csv_columns,
+    csv_header,
+    default_columns,
+)
+from strapdown.rotation.dcm import quat_from_dcm
+from strapdown.rotation.euler import dcm_from_euler_zyx
+
+__all__ = ["ACC_UNITS", "NAV_COLUMNS", "AccUnit", "NavLog", "increments_from_rates",
+           "navigate_log", "read_nav_log"]
+
+#: Accelerometer units: specific force (m/s², g) for rate logs, velocity increments (m/s).
+AccUnit = Literal["m/s2", "g", "m/s"]
+ACC_UNITS: tuple[AccUnit, ...] = get_args(AccUnit)
+_ACC_ALLOWED: dict[InputKind, tuple[AccUnit, ...]] = {"rate": ("m/s2", "g"),
+                                                      "increment": ("m/s",)}
+#: Output columns, one row per update.
+NAV_COLUMNS = ("t", "lat_deg", "lon_deg", "height_m", "vn", "ve", "vd", "qw", "qx", "qy", "qz")
+G0 = 9.80665
+CHUNK = 1 << 15
+
+
+@dataclass(frozen=True)
+class NavLog:
+    """A validated nav log in SI units on a uniform time base.
+
+    ``t`` (n,) stamps (s: rate sample times, or increment interval ends); ``gyro``,
+    ``accel`` (n, 3) rates (rad/s, m/s²) or increments (rad, m/s); ``h`` the sample period;
+    ``units`` and ``acc_units`` what the file was in.
+    """
+
+    t: NDArray[np.float64]
+    gyro: NDArray[np.float64]
+    accel: NDArray[np.float64]
+    kind: InputKind
+    h: float
+    units: str | None
+    acc_units: str
+
+
+def _csv_accel(path: Path, columns: Sequence[str] | None) -> tuple[NDArray[np.float64],
+                                                                     str | None]:
+    names, _ = csv_header(path)
+    if columns is None:
+        cols, _ = default_columns(path, [("gyro", GYRO_COLUMNS), ("accelerometer", ACC_COLUMNS)])
+        acc = cols[4:7]
+    else:
+        acc = list(columns[4:7])
+        missing = [c for c in acc if c not in names]
+        if missing:
+            raise ValueError(f"{path}: no accelerometer columns {missing} in the header {names}")
+    raw, units, _ = csv_columns(path, acc)
+    found = {units[c] for c in acc if c in units}
+    if len(found) > 1:
+        raise ValueError(f"{path}: the header gives the accelerometer axes different units "
+                         f"{sorted(found)}")
+    return raw, (found.pop() if found else None)
+
+
+def _accel_source(path: Path, columns: Sequence[str] | None
+                  ) -> tuple[NDArray[np.float64], str | None]:
+    """The accelerometer values of any supported file and the unit it states (or None)."""
+    suffix = path.suffix.lower()
+    if suffix == ".csv":
+        return _csv_accel(path, columns)
+    if suffix == ".npz":
+        with np.load(path) as z:
+            if "accel" not in z:
+                raise ValueError(f"{path}: no accelerometer array 'accel' (found "
+                                 f"{sorted(z.keys())})")
+            return np.asarray(z["accel"], float), None
+    if suffix in (".h5", ".hdf5"):
+        import h5py  # read_imu has already said how to install it when it is missing
+
+        with h5py.File(path, "r") as f:
+            for key, unit in (("accel", None), ("imu_acc", "m/s2")):
+                if key in f:
+                    return np.asarray(f[key], float), unit
+            raise ValueError(f"{path}: no accelerometer dataset 'accel' (or BROAD's 'imu_acc'); "
+                             f"found {sorted(f.keys())}")
+    if suffix == ".mat":
+        from scipy.io import loadmat
+
+        m = loadmat(path)
+        if "imu_acc" in m:  # BROAD: m/s²
+            return np.asarray(m["imu_acc"], float), "m/s2"
+        for key in ("avp_imu", "imu", "wvt"):  # PSINS [wm vm t]: vm in m/s
+            if key in m:
+                return np.asarray(m[key], float)[:, 3:6], "m/s"
+        raise ValueError(f"{path}: no accelerometer ('imu_acc' or PSINS [wm vm t])")
+    raise ValueError(f"{path}: nav logs are .csv, .npz, .h5/.hdf5 or .mat, not {suffix!r}")
+
+
+def _acc_unit(path: Path, kind: InputKind, declared: str | None, stated: str | None) -> str:
+    allowed = _ACC_ALLOWED[kind]
+    if stated is not None:
+        stated = canonical_unit(stated)
+        if stated not in allowed:
+            raise ValueError(f"{path}: the accelerometer is in {stated!r}; a {kind} log needs "
+                             f"one of {allowed}")
+        if declared is not None and declared != stated:
+            raise ValueError(f"{path}: declared accelerometer units {declared!r} contradict "
+                             f"the file's {stated!r}")
+        return stated
+    if declared is None:
+        raise ValueError(f"{path}: no accelerometer units declared; pass --acc-units or write "
+                         f"them in the header (e.g. ax[{'m/s^2' if kind == 'rate' else 'm/s'}])")
+    if declared not in allowed:
+        raise ValueError(f"{path}: accelerometer units {declared!r} do not fit a {kind} log; "
+                         f"use one of {allowed}")
+    return declared
+
+
+def _check_acc_magnitude(path: Path, f: NDArray[np.float64], unit: str,
+                         action: UnitAction) -> None:
+    """A median specific-force norm (in the declared unit) that suggests the other unit."""
+    med = float(np.median(np.linalg.norm(f, axis=1)))
+    msg = None
+    if unit != "g" and 0.3 < med < 3.0:
+        msg = (f"{path}: median accelerometer norm {med:.3g} m/s² is implausible (gravity "
+               f"alone gives 9.8); the log is more likely in g (declared {unit})")
+    elif unit == "g" and 3.0 < med < 30.0:
+        msg = (f"{path}: median accelerometer norm {med:.3g} g is implausible; the log is "
+               "more likely in m/s² (declared g)")
+    if msg is None:
+        return
+    if action == "error":
+        raise ValueError(f"{msg}; nothing computed. If the declared units are right, pass "
+                         "--accept-unit-warning")
+    warnings.warn(msg, UnitWarning, stacklevel=3)
+
+
+def _uniform_period(path: Path, t: NDArray[np.float64], nominal: float | None) -> float:
+    """The sample period; stamps straying over :data:`JITTER_TOLERANCE` periods from the
+    uniform grid are an error (the navigation needs a fixed interval)."""
+    k = np.arange(t.size)
+    td = nominal if nominal is not None else float((t[-1] - t[0]) / (t.size - 1))
+    resid = (t - t[0]) - k * td
+    resid -= resid.mean()
+    worst = int(np.argmax(np.abs(resid)))
+    if abs(resid[worst]) > JITTER_TOLERANCE * td:
+        raise ValueError(f"{path}: time stamps not uniform: data row {worst + 1} lies "
+                         f"{abs(resid[worst]) / td:.3g} periods off the grid of period "
+                         f"{td:.9g} s; navigation needs uniformly sampled logs")
+    return td
+
+
+def read_nav_log(path: str | os.PathLike[str], *, kind: InputKind = "rate",
+                 units: GyroUnit | None = None, acc_units: AccUnit | None = None,
+                 columns: Sequence[str] | None = None, sample_rate_hz: float | None = None,
+                 unit_check: UnitAction = "error") -> NavLog:
+    """Read and validate a nav log (see the module docstring).
+
+    Parameters
+    ----------
+    kind : {"rate", "increment"}
+    units : gyro units (as :func:`strapdown.io.read_imu`), None: the file's
+    acc_units : {"m/s2", "g"} for rates, {"m/s"} for increments; None: the file's
+    columns : seven CSV names (time, gyro x y z, accelerometer x y z), optional
+    sample_rate_hz : float, optional
+        The sensor's rate (needed where the file carries none).
+    unit_check : {"warn", "error"}
+        What magnitudes that suggest the other unit do (gyro and accelerometer).
+    """
+    path = Path(path)
+    if columns is not None and len(columns) != 7:
+        raise ValueError(f"columns must name time, three gyro and three accelerometer axes, "
+                         f"got {len(columns)}: {list(columns)}")
+    if acc_units is not None and acc_units not in ACC_UNITS:
+        raise ValueError(f"accelerometer units must be one of {ACC_UNITS}, got {acc_units!r}")
+    if path.suffix.lower() == ".npy":
+        raise ValueError(f"{path}: .npy logs hold a gyro only; a nav log is .csv, .npz, "
+                         ".h5/.hdf5 or .mat")
+    log = read_imu(path, kind=kind, units=units,
+                   columns=None if columns is None else list(columns[:4]),
+                   sample_rate_hz=sample_rate_hz, on_gap="error", unit_check=unit_check)
+    acc, stated = _accel_source(path, columns)
+    if acc.ndim != 2 or acc.shape != log.data.shape:
+        raise ValueError(f"{path}: {log.data.shape[0]} gyro samples but accelerometer values of "
+                         f"shape {acc.shape}")
+    check_rows(path, log.t, [("accelerometer", [acc])])
+    unit = _acc_unit(path, kind, acc_units, stated)
+    h = _uniform_period(path, log.t, log.nominal_period)
+    _check_acc_magnitude(path, acc if kind == "rate" else acc / h, unit, unit_check)
+    si = acc * G0 if unit == "g" else acc
+    return NavLog(log.t, log.data, np.ascontiguousarray(si), kind, h, log.units, unit)
+
+
+def increments_from_rates(w: ArrayLike, h: float) -> NDArray[np.float64]:
+    """Increments over the ``n − 1`` intervals between ``n`` uniform samples ``w`` (n, 3).
+
+    Interior intervals integrate the cubic through the four neighbouring samples,
+    ``h/24 (−w_{k−2} + 13 w_{k−1} + 13 w_k − w_{k+1})``; the first and last the quadratic
+    through three, ``h/12 (5 w_0 + 8 w_1 − w_2)`` and its mirror; two samples, the
+    trapezoid. Exact for cubics (quadratics at the ends).
+    """
+    w = np.asarray(w, dtype=np.float64)
+    n = w.shape[0]
+    if n < 2:
+        raise ValueError(f"rates give increments between samples: need at least 2, got {n}")
+    if n == 2:
+        return 0.5 * h * (w[:1] + w[1:])
+    out = np.empty((n - 1, 3))
+    out[0] = h / 12 * (5 * w[0] + 8 * w[1] - w[2])
+    out[-1] = h / 12 * (-w[-3] + 8 * w[-2] + 5 * w[-1])
+    if n > 3:
+        out[1:-1] = h / 24 * (-w[:-3] + 13 * w[1:-2] + 13 * w[2:-1] - w[3:])
+    return out
+
+
+def _initial_state(lat_deg: float, lon_deg: float, height: float,
+                   velocity: ArrayLike | None, attitude_deg: ArrayLike | None
+                   ) -> tuple[float, float, float, NDArray[np.float64], NDArray[np.float64]]:
+    """(lat, lon rad, height, v NED, q_n_b) from the command line's initial state."""
+    for name, c in (("latitude", lat_deg), ("longitude", lon_deg), ("height", height)):
+        if not math.isfinite(c):
+            raise ValueError(f"initial {name} must be finite, got {c}")
+    if not abs(lat_deg) < 90.0:
+        raise ValueError(f"initial latitude must lie within ±90°, got {lat_deg}°")
+    v = np.zeros(3) if velocity is None else np.asarray(velocity, dtype=np.float64)
+    ypr = np.zeros(3) if attitude_deg is None else np.asarray(attitude_deg, dtype=np.float64)
+    for name, x in (("velocity (VN VE VD)", v), ("attitude (YAW PITCH ROLL)", ypr)):
+        if x.shape != (3,):
+            raise ValueError(f"initial {name} needs three values, got {x.size}")
+        if not np.all(np.isfinite(x)):
+            raise ValueError(f"initial {name} must be finite, got {x.tolist()}")
+    q = quat_from_dcm(dcm_from_euler_zyx(*np.radians(ypr)))
+    return math.radians(lat_deg), math.radians(lon_deg), float(height), v, q
+
+
+def _rows(sol) -> NDArray[np.float64]:
+    return np.column_stack([sol.t, np.degrees(sol.lat), np.degrees(sol.lon), sol.height,
+                            sol.v, sol.q])
+
+
+def _check_out(imu: Path, out: Path) -> None:
+    if out.resolve() == imu.resolve():
+        raise ValueError("--out must not be the input file")
+    if out.suffix.lower() not in (".csv", ".npz"):
+        raise ValueError(f"{out}: output must be .csv or .npz")
+
+
+def navigate_log(imu: str | os.PathLike[str], out: str | os.PathLike[str], *, lat_deg: float,
+                 lon_deg: float, height: float, velocity: ArrayLike | None = None,
+                 attitude_deg: ArrayLike | None = None, kind: InputKind = "rate",
+                 units: GyroUnit | None = None, acc_units: AccUnit | None = None,
+                 columns: Sequence[str] | None = None, sample_rate_hz: float | None = None,
+                 subsamples: int = 2, structure: str = "conventional", sculling: bool = True,
+                 accept_unit_warning: bool = False, progress: bool = False) -> dict[str, Any]:
+    """Navigate a log and write one row per update (see the module docstring).
+
+    Parameters
+    ----------
+    lat_deg, lon_deg, height : float
+        Initial position (°, °, m above the WGS-84 ellipsoid).
+    velocity : (VN, VE, VD) m/s, optional (default at rest)
+    attitude_deg : (yaw, pitch, roll) °, z-y-x in NED, optional (default level, north)
+    subsamples, structure, sculling
+        As :func:`strapdown.algorithms.navigation.navigate`.
+    accept_unit_warning : bool
+        Magnitudes that suggest other units than declared warn instead of failing.
+    progress : bool
+        A progress bar on stderr.
+
+    Returns a summary: samples, outputs, sample period, units, warnings.
+    """
+    imu_path, out_path = Path(imu), Path(out)
+    _check_out(imu_path, out_path)
+    lat, lon, hgt, v0, q0 = _initial_state(lat_deg, lon_deg, height, velocity, attitude_deg)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        log = read_nav_log(imu_path, kind=kind, units=units, acc_units=acc_units,
+                           columns=columns, sample_rate_hz=sample_rate_hz,
+                           unit_check="warn" if accept_unit_warning else "error")
+    if kind == "rate":
+        g, a = increments_from_rates(log.gyro, log.h), increments_from_rates(log.accel, log.h)
+        t0 = float(log.t[0])
+    else:
+        g, a, t0 = log.gyro, log.accel, float(log.t[0]) - log.h
+    stream = NavStream(subsamples, h=log.h, lat=lat, lon=lon, height=hgt, v0=v0, q0=q0,
+                       structure=structure, t0=t0, sculling=sculling)
+    n_out = _stream_to(out_path, stream, g, a, progress)
+    return {"samples": int(log.t.size), "outputs": n_out, "sample_period_s": log.h,
+            "update_period_s": stream.update_period, "units": log.units,
+            "acc_units": log.acc_units, "warnings": [str(w.message) for w in caught]}
+
+
+def _stream_to(out: Path, stream: NavStream, g: NDArray[np.float64], a: NDArray[np.float64],
+               progress: bool) -> int:
+    """Feed the increments in chunks, writing each chunk's rows as they come."""
+    csv_out = out.suffix.lower() == ".csv"
+    parts, n_out = [], 0
+    with atomic_path(out) as tmp, open(tmp, "w", encoding="utf-8") as f, \
+            tqdm(total=g.shape[0], disable=not progress, unit="sample", unit_scale=True,
+                 file=sys.stderr) as bar:
+        if csv_out:
+            f.write(",".join(NAV_COLUMNS) + "\n")
+        for s in range(0, g.shape[0], CHUNK):
+            sol = stream.feed(g[s:s + CHUNK], a[s:s + CHUNK])
+            bar.update(min(CHUNK, g.shape[0] - s))
+            rows = _rows(sol)
+            if not np.all(np.isfinite(rows)):
+                i = int(np.argmax(~np.all(np.isfinite(rows), axis=1)))
+                raise ValueError(f"the navigation diverged (NaN or infinity) at t = "
+                                 f"{rows[i, 0]:.6g} s; nothing written")
+            n_out += rows.shape[0]
+            if csv_out:
+                np.savetxt(f, rows, delimiter=",", fmt="%.17g")
+            else:
+                parts.append(rows)
+        if n_out == 0:
+            raise ValueError(f"{stream.n} subsamples per update need at least {stream.n} "
+                             f"intervals, the log has {g.shape[0]}; nothing written")
+        if not csv_out:
+            f.close()
+            table = np.concatenate(parts)
+            # Any: np.savez's column keywords share its signature with allow_pickle: bool
+            cols: dict[str, Any] = {k: table[:, i] for i, k in enumerate(NAV_COLUMNS)}
+            with open(tmp, "wb") as fb:
+                np.savez(fb, **cols)
+    return n_out

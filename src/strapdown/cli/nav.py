@@ -1,0 +1,89 @@
+"""``strapdown nav``: position, velocity and attitude on the WGS-84 Earth from a gyro and
+accelerometer log, streamed, written atomically."""
+
+from __future__ import annotations
+
+import argparse
+
+from strapdown.cli._common import columns, progress, progress_args, say
+
+__all__ = ["add_parser", "run"]
+
+
+def add_parser(subparsers) -> argparse.ArgumentParser:
+    """Register ``nav`` (its options are added when it is used)."""
+    p = subparsers.add_parser(
+        "nav", arguments=_arguments,
+        help="navigate a gyro + accelerometer log on the WGS-84 Earth (NED)",
+        description="Validate a gyro and accelerometer log, navigate it from the initial "
+        "position, velocity and attitude (coning and sculling compensated, NED on WGS-84) and "
+        "write t,lat_deg,lon_deg,height_m,vn,ve,vd,qw,qx,qy,qz, one row per update, "
+        "atomically.")
+    p.set_defaults(handler=run)
+    return p
+
+
+def _arguments(p: argparse.ArgumentParser) -> None:
+    from strapdown.algorithms.velocity import NAV_STRUCTURES
+    from strapdown.apps.nav import ACC_UNITS
+    from strapdown.io.readers import INCREMENT_UNITS, RATE_UNITS
+
+    g = p.add_argument_group("log")
+    g.add_argument("--imu", required=True,
+                   help="input log: CSV with a header, .npz/HDF5 (t, gyro, accel) or .mat")
+    kind = g.add_mutually_exclusive_group()
+    kind.add_argument("--rates", dest="kind", action="store_const", const="rate",
+                      default="rate", help="the log holds rates and specific force (default)")
+    kind.add_argument("--increments", dest="kind", action="store_const", const="increment",
+                      help="the log holds angular (rad) and velocity (m/s) increments")
+    g.add_argument("--units", default=None, choices=(*RATE_UNITS, *INCREMENT_UNITS),
+                   help="gyro units (required unless the header declares them, e.g. "
+                   "gx[deg/s])")
+    g.add_argument("--acc-units", default=None, choices=ACC_UNITS,
+                   help="accelerometer units: m/s2 or g for rates, m/s for increments "
+                   "(required unless the header declares them, e.g. ax[m/s^2])")
+    g.add_argument("--columns", default=None,
+                   help="CSV columns for time, gyro x,y,z and accelerometer x,y,z, "
+                   "comma-separated (default: found in the header, t,gx,gy,gz,ax,ay,az)")
+    g.add_argument("--sample-rate-hz", type=float, default=None,
+                   help="the sensor's sample rate (Hz), for files without time stamps")
+    g.add_argument("--accept-unit-warning", action="store_true",
+                   help="run although magnitudes suggest other units than declared")
+    s = p.add_argument_group("initial state")
+    s.add_argument("--init-lat", type=float, required=True, help="latitude (deg)")
+    s.add_argument("--init-lon", type=float, required=True, help="longitude (deg)")
+    s.add_argument("--init-height", type=float, required=True,
+                   help="height above the WGS-84 ellipsoid (m)")
+    s.add_argument("--init-velocity", type=float, nargs=3, metavar=("VN", "VE", "VD"),
+                   default=None, help="NED velocity (m/s; default at rest)")
+    s.add_argument("--init-attitude", type=float, nargs=3, metavar=("YAW", "PITCH", "ROLL"),
+                   default=None, help="z-y-x Euler angles of the body in NED (deg; default 0 0 0)")
+    a = p.add_argument_group("algorithm")
+    a.add_argument("--structure", choices=NAV_STRUCTURES, default="conventional",
+                   help="conventional: an update every N samples; single-chain: every sample")
+    a.add_argument("--subsamples", type=int, default=2,
+                   help="N of the coning and sculling corrections (1-6)")
+    a.add_argument("--no-sculling", dest="sculling", action="store_false",
+                   help="drop the sculling correction (rotation compensation only)")
+    o = p.add_argument_group("output")
+    progress_args(o)
+    o.add_argument("--out", required=True, help="output .csv or .npz")
+
+
+def run(args: argparse.Namespace) -> int:
+    """Navigate the log and write the solution; warnings go to stderr."""
+    from strapdown.apps.nav import navigate_log
+
+    res = navigate_log(args.imu, args.out, lat_deg=args.init_lat, lon_deg=args.init_lon,
+                       height=args.init_height, velocity=args.init_velocity,
+                       attitude_deg=args.init_attitude, kind=args.kind, units=args.units,
+                       acc_units=args.acc_units,
+                       columns=None if args.columns is None else columns(args.columns),
+                       sample_rate_hz=args.sample_rate_hz, subsamples=args.subsamples,
+                       structure=args.structure, sculling=args.sculling,
+                       accept_unit_warning=args.accept_unit_warning, progress=progress(args))
+    for w in res["warnings"]:
+        say(f"warning: {w}")
+    print(f"wrote {args.out}: {res['outputs']} updates from {res['samples']} samples "
+          f"(update every {res['update_period_s']:.6g} s)")
+    return 0
