@@ -27,13 +27,10 @@ if TYPE_CHECKING:
     from strapdown.truth.motions import Motion
 
 __all__ = [
-    "AlgorithmName",
     "DriftLaw",
     "Family",
     "IncrementStructure",
     "InputKind",
-    "QuaternionAlgorithmName",
-    "RateAlgorithmName",
     "RateCoefficients",
     "Rk4Step",
     "StructureName",
@@ -41,12 +38,9 @@ __all__ = [
 
 # The vocabulary of an algorithm spec: every string option, once. The run-time tuples
 # (spec.ALGORITHMS, structures.STRUCTURES, rate.RK4_STEPS …) are derived from these.
-#: The rate-input families (:mod:`.rate`).
-RateAlgorithmName = Literal["rate-single", "rate-three", "rk4"]
-#: Plaksiy's quaternion algorithms A1–A3 (:mod:`.quaternion`).
-QuaternionAlgorithmName = Literal["miller", "panov", "power"]
-#: Every registered family, in registry order (:data:`strapdown.algorithms.spec.REGISTRY`).
-AlgorithmName = Literal["rotvec", RateAlgorithmName, QuaternionAlgorithmName]
+# The family names are declared beside their families (rotvec.RotvecName,
+# rate.RateAlgorithmName, quaternion.QuaternionAlgorithmName) and joined in
+# spec.AlgorithmName, so that a new family is one module's change.
 #: The update structures of increment input (:mod:`.structures`).
 IncrementStructure = Literal["conventional", "realtime", "single-chain"]
 #: Every update structure some family runs in (``sliding``: Wang et al.'s scheme of
@@ -81,7 +75,7 @@ class Family:
     """
 
     #: Registry name, the first field of a spec string.
-    name: ClassVar[AlgorithmName]
+    name: ClassVar[str]  # an AlgorithmName (spec.py joins the families' names)
     #: What the algorithm consumes: angular increments (rad) or rate samples (rad/s).
     input_kind: ClassVar[InputKind]
     #: Update structures it runs in; the first is the default.

@@ -19,14 +19,14 @@ exponential map. ``exact_exp=True`` uses the exponential map instead (for A3:
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, ClassVar, get_args
+from typing import TYPE_CHECKING, ClassVar, Literal, get_args
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from strapdown._core.validation import as_quaternions, as_vectors, finite_array, positive
 from strapdown.algorithms import _kernels
-from strapdown.algorithms.family import Family, QuaternionAlgorithmName
+from strapdown.algorithms.family import Family
 from strapdown.algorithms.structures import AttitudeSolution
 
 if TYPE_CHECKING:
@@ -35,7 +35,9 @@ if TYPE_CHECKING:
 __all__ = ["ALGORITHMS", "FAMILIES", "STATED", "QuaternionAlgorithm", "quaternion_attitude",
            "subintervals"]
 
-#: The algorithms (:data:`~strapdown.algorithms.family.QuaternionAlgorithmName`).
+#: Plaksiy's quaternion algorithms A1–A3, the families defined here.
+QuaternionAlgorithmName = Literal["miller", "panov", "power"]
+#: The algorithms (:data:`QuaternionAlgorithmName`).
 ALGORITHMS: tuple[QuaternionAlgorithmName, ...] = get_args(QuaternionAlgorithmName)
 #: Coefficients as the paper states them (α, β).
 STATED: dict[QuaternionAlgorithmName, tuple[float, float]] = {

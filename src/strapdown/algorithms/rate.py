@@ -31,7 +31,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from fractions import Fraction
-from typing import TYPE_CHECKING, Any, ClassVar, get_args
+from typing import TYPE_CHECKING, Any, ClassVar, Literal, get_args
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -42,7 +42,6 @@ from strapdown.algorithms.coning import WindowedAlgorithm
 from strapdown.algorithms.family import (
     DriftLaw,
     Family,
-    RateAlgorithmName,
     RateCoefficients,
     Rk4Step,
     StructureName,
@@ -71,6 +70,8 @@ __all__ = [
 ]
 
 F = Fraction
+#: The rate-input families defined here, in registry order.
+RateAlgorithmName = Literal["rate-single", "rate-three", "rk4"]
 #: Coefficient sets of the rate algorithms (:data:`~strapdown.algorithms.family.RateCoefficients`).
 COEFFICIENTS: tuple[RateCoefficients, ...] = get_args(RateCoefficients)
 #: RK4 step variants (:data:`~strapdown.algorithms.family.Rk4Step`).
@@ -486,7 +487,7 @@ class Rk4(Family):
 
 #: The families this module defines, in registry order.
 FAMILIES: tuple[Family, ...] = (RateSingle(), RateThree(), Rk4())
-#: Their names (:data:`~strapdown.algorithms.family.RateAlgorithmName`), in registry order.
+#: Their names (:data:`RateAlgorithmName`), in registry order.
 ALGORITHMS: tuple[RateAlgorithmName, ...] = get_args(RateAlgorithmName)
 
 

@@ -15,7 +15,7 @@ design (:func:`strapdown.design.single_chain_structure`).
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar, Literal
 
 from strapdown.algorithms.coning import (
     CoefficientSet,
@@ -35,7 +35,10 @@ if TYPE_CHECKING:
     from strapdown.algorithms.spec import AlgorithmSpec
     from strapdown.truth.motions import Motion
 
-__all__ = ["FAMILIES", "Rotvec"]
+__all__ = ["FAMILIES", "Rotvec", "RotvecName"]
+
+#: The family defined here.
+RotvecName = Literal["rotvec"]
 
 
 class Rotvec(Family):

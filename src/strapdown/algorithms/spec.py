@@ -21,13 +21,12 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, get_args
+from typing import TYPE_CHECKING, Any, Literal, cast, get_args
 
 from strapdown._core.validation import positive, positive_int
 from strapdown.algorithms import quaternion, rate, rotvec
 from strapdown.algorithms.coning import MAX_SUBSAMPLES, ConingSetName
 from strapdown.algorithms.family import (
-    AlgorithmName,
     DriftLaw,
     Family,
     InputKind,
@@ -35,6 +34,9 @@ from strapdown.algorithms.family import (
     Rk4Step,
     StructureName,
 )
+from strapdown.algorithms.quaternion import QuaternionAlgorithmName
+from strapdown.algorithms.rate import RateAlgorithmName
+from strapdown.algorithms.rotvec import RotvecName
 from strapdown.algorithms.structures import AttitudeSolution
 
 if TYPE_CHECKING:
@@ -59,9 +61,12 @@ __all__ = [
 
 #: A coefficient set some family takes: a named coning set or a rate-algorithm set.
 CoefficientName = ConingSetName | RateCoefficients
+#: Every registered family, in registry order: the names each family module declares.
+AlgorithmName = Literal[RotvecName, RateAlgorithmName, QuaternionAlgorithmName]
 #: Every registered family by name, in the order the command line lists them.
-REGISTRY: dict[AlgorithmName, Family] = {f.name: f for f in (*rotvec.FAMILIES, *rate.FAMILIES,
-                                                              *quaternion.FAMILIES)}
+REGISTRY: dict[AlgorithmName, Family] = {
+    cast("AlgorithmName", f.name): f
+    for f in (*rotvec.FAMILIES, *rate.FAMILIES, *quaternion.FAMILIES)}
 if tuple(REGISTRY) != get_args(AlgorithmName):  # the one list of names is the Literal
     raise RuntimeError(f"the registry {tuple(REGISTRY)} and AlgorithmName "
                        f"{get_args(AlgorithmName)} disagree; a family was added to one only")

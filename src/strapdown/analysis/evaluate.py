@@ -19,9 +19,14 @@ from strapdown import analysis
 from strapdown._core.kinds import InputKind
 from strapdown._core.validation import positive, positive_int
 from strapdown.algorithms.coning import CoefficientSet
-from strapdown.algorithms.family import AlgorithmName, Rk4Step, StructureName
+from strapdown.algorithms.family import Rk4Step, StructureName
 from strapdown.algorithms.precision import run_mp
-from strapdown.algorithms.spec import AlgorithmSpec, CoefficientName, algorithms_taking
+from strapdown.algorithms.spec import (
+    AlgorithmName,
+    AlgorithmSpec,
+    CoefficientName,
+    algorithms_taking,
+)
 from strapdown.algorithms.structures import increment_structure, run_structure
 from strapdown.analysis.law import LawResolution, judge_law
 from strapdown.truth import sensors

@@ -29,9 +29,14 @@ from tqdm import tqdm
 
 from strapdown._core.kinds import InputKind
 from strapdown._core.validation import first_bad_step
-from strapdown.algorithms.family import AlgorithmName, StructureName
+from strapdown.algorithms.family import StructureName
 from strapdown.algorithms.rotvec import Rotvec
-from strapdown.algorithms.spec import AlgorithmSpec, CoefficientName, algorithms_taking
+from strapdown.algorithms.spec import (
+    AlgorithmName,
+    AlgorithmSpec,
+    CoefficientName,
+    algorithms_taking,
+)
 from strapdown.algorithms.streaming import RotvecStream
 from strapdown.algorithms.structures import increment_structure
 from strapdown.apps._logs import check_finite, output_with_sidecar, rate_records, unit_action

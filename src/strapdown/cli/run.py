@@ -18,7 +18,7 @@ from strapdown.cli._common import (
 )
 
 if TYPE_CHECKING:
-    from strapdown.algorithms.family import AlgorithmName
+    from strapdown.algorithms.spec import AlgorithmName
 
 __all__ = ["add_parser", "run"]
 

@@ -23,9 +23,9 @@ from typing import Any, Literal, get_args
 from strapdown._core.series import SMALL_ANGLE
 from strapdown._core.validation import positive
 from strapdown.algorithms.coning import coefficient_set
-from strapdown.algorithms.family import AlgorithmName, StructureName
+from strapdown.algorithms.family import StructureName
 from strapdown.algorithms.spec import ALGORITHMS as REGISTERED
-from strapdown.algorithms.spec import AlgorithmSpec, CoefficientName
+from strapdown.algorithms.spec import AlgorithmName, AlgorithmSpec, CoefficientName
 from strapdown.io.files import write_text
 
 __all__ = ["ALGORITHMS", "REALS", "CExport", "CReal", "export_c", "generate"]

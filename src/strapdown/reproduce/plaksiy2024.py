@@ -24,11 +24,11 @@ from pathlib import Path
 import numpy as np
 
 from strapdown import analysis
-from strapdown.algorithms.family import QuaternionAlgorithmName
 from strapdown.algorithms.quaternion import (
     ALGORITHMS,
     STATED,
     QuaternionAlgorithm,
+    QuaternionAlgorithmName,
     quaternion_attitude,
     subintervals,
 )

@@ -26,7 +26,8 @@ import numpy as np
 
 from strapdown import analysis
 from strapdown.algorithms import rate
-from strapdown.algorithms.family import RateAlgorithmName, RateCoefficients, Rk4Step, StructureName
+from strapdown.algorithms.family import RateCoefficients, Rk4Step, StructureName
+from strapdown.algorithms.rate import RateAlgorithmName
 from strapdown.algorithms.spec import AlgorithmSpec
 from strapdown.analysis.evaluate import EvaluationConfig, evaluate
 from strapdown.io.report import Report
