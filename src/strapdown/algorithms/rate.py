@@ -335,7 +335,7 @@ def _coefficients(spec: AlgorithmSpec) -> RateCoefficients:
     return _rate_coefficients(spec.resolved_coefficients)
 
 
-class _RateFamily(Family):
+class WindowedRateFamily(Family):
     """Shared by the windowed rate families: validated record in, attitude out."""
 
     input_kind = "rate"
@@ -375,7 +375,7 @@ class _RateFamily(Family):
                     lag=w.span if sliding else 1, start_c=start_c, rk4=False)
 
 
-class RateSingle(_RateFamily):
+class RateSingle(WindowedRateFamily):
     """``rate-single``: ΔΦ = td/2 (ω₀ + ω₁) + c td² ω₀ × ω₁, an update every td."""
 
     name = "rate-single"
@@ -402,7 +402,7 @@ class RateSingle(_RateFamily):
                                digits=digits)
 
 
-class RateThree(_RateFamily):
+class RateThree(WindowedRateFamily):
     """``rate-three``: the three-period cubic-fit algorithm, conventional or sliding."""
 
     name = "rate-three"

@@ -23,9 +23,10 @@ from typing import Any, Literal, get_args
 from strapdown._core.series import SMALL_ANGLE
 from strapdown._core.validation import positive
 from strapdown.algorithms.coning import coefficient_set
-from strapdown.algorithms.family import StructureName
-from strapdown.algorithms.spec import ALGORITHMS as REGISTERED
-from strapdown.algorithms.spec import AlgorithmName, AlgorithmSpec, CoefficientName
+from strapdown.algorithms.family import Family, StructureName
+from strapdown.algorithms.rate import Rk4, WindowedRateFamily
+from strapdown.algorithms.rotvec import Rotvec
+from strapdown.algorithms.spec import REGISTRY, AlgorithmName, AlgorithmSpec, CoefficientName
 from strapdown.io.files import write_text
 
 __all__ = ["ALGORITHMS", "REALS", "CExport", "CReal", "export_c", "generate"]
@@ -457,12 +458,26 @@ int NAME_update(NAME_state *s, const real_t sample[3], real_t q_out[4])
     return struct, body, ops, f"quaternion RK4, step 2 td, td = {h!r} s"
 
 
-#: C generator per exportable family (the C templates are the exporter's own knowledge).
-_GENERATORS: dict[AlgorithmName, Callable[[AlgorithmSpec, CReal, float],
-                                           tuple[str, str, dict[str, int], str]]] = {
-    "rotvec": _gen_rotvec, "rate-single": _gen_rate, "rate-three": _gen_rate, "rk4": _gen_rk4}
+_Generator = Callable[[AlgorithmSpec, CReal, float], tuple[str, str, dict[str, int], str]]
+
+
+def _generator(family: Family) -> _Generator | None:
+    """The C template for a family (the templates are the exporter's own knowledge): the
+    rotation vector, RK4, and every windowed rate family through one template."""
+    if isinstance(family, Rotvec):
+        return _gen_rotvec
+    if isinstance(family, Rk4):
+        return _gen_rk4
+    if isinstance(family, WindowedRateFamily):
+        return _gen_rate
+    return None
+
+
+#: C generator per exportable family, in registry order.
+_GENERATORS: dict[AlgorithmName, _Generator] = {
+    name: g for name, fam in REGISTRY.items() if (g := _generator(fam)) is not None}
 #: Families ``export-c`` can generate, in registry order.
-ALGORITHMS: tuple[AlgorithmName, ...] = tuple(a for a in REGISTERED if a in _GENERATORS)
+ALGORITHMS: tuple[AlgorithmName, ...] = tuple(_GENERATORS)
 
 
 def export_c(out: str | Path, **kwargs: Any) -> CExport:
