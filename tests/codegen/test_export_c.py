@@ -2,14 +2,12 @@
 
 from __future__ import annotations
 
-import ctypes
 import math
-import shutil
-import subprocess
 
 import numpy as np
 import pytest
 
+from c_harness import build, drive
 from strapdown.algorithms import rate
 from strapdown.algorithms.coning import coefficient_set
 from strapdown.algorithms.structures import conventional, realtime, single_chain
@@ -19,46 +17,6 @@ from strapdown.truth.motions import SpinConing
 STEPS = 100_000
 H = 1e-4
 MOTION = SpinConing(math.radians(2.0), 2 * math.pi * 5, math.radians(3600.0))
-FLAGS = ["-std=c99", "-Wall", "-Wextra", "-Werror", "-O2", "-fPIC", "-shared",
-         "-ffp-contract=off"]
-
-
-def _compiler() -> str:
-    cc = shutil.which("cc") or shutil.which("gcc") or shutil.which("clang")
-    if cc is None:
-        pytest.fail("no C compiler (cc, gcc or clang) on PATH: the export-c equivalence "
-                    "harness needs one; install gcc")
-    return cc
-
-
-def _build(tmp_path, **kw):
-    e = export_c(tmp_path, **kw)
-    lib = tmp_path / f"lib{e.name}.so"
-    res = subprocess.run([_compiler(), *FLAGS, "-o", str(lib), str(tmp_path / f"{e.name}.c"),
-                          "-lm"], capture_output=True, text=True)
-    assert res.returncode == 0, res.stderr
-    return e, ctypes.CDLL(str(lib))
-
-
-def _drive(e, lib, samples, q0):
-    real = ctypes.c_double if e.real == "double" else ctypes.c_float
-    dt = np.float64 if e.real == "double" else np.float32
-    getattr(lib, f"{e.name}_state_size").restype = ctypes.c_ulong
-    state = ctypes.create_string_buffer(int(getattr(lib, f"{e.name}_state_size")()))
-    update = getattr(lib, f"{e.name}_update")
-    update.restype = ctypes.c_int
-    getattr(lib, f"{e.name}_init")(state, np.asarray(q0, dt).ctypes.data_as(
-        ctypes.POINTER(real)))
-    out = np.zeros(4, dt)
-    po = out.ctypes.data_as(ctypes.POINTER(real))
-    xs = np.ascontiguousarray(samples, dtype=dt)
-    rows = [np.asarray(q0, float)]
-    for k in range(xs.shape[0]):
-        if update(state, xs[k].ctypes.data_as(ctypes.POINTER(real)), po):
-            rows.append(out.astype(float).copy())
-    return np.array(rows)
-
-
 def _increments():
     return MOTION.increments(np.arange(STEPS + 1) * H)
 
@@ -92,9 +50,9 @@ def _python(alg, structure, n, q0):
 @pytest.mark.parametrize(("alg", "structure", "n"), CASES)
 def test_double_matches_python(tmp_path, alg, structure, n):
     q0 = MOTION.attitude(0.0)
-    e, lib = _build(tmp_path, algorithm=alg, structure=structure, subsamples=max(n, 1), h=H)
+    e, lib = build(tmp_path, algorithm=alg, structure=structure, subsamples=max(n, 1), h=H)
     x = _increments() if alg == "rotvec" else _rates()[1]
-    c = _drive(e, lib, x, q0)
+    c = drive(e, lib, x, q0)
     py = _python(alg, structure, n, q0)
     assert c.shape == py.shape
     assert np.max(np.abs(c - py)) <= 1e-13
@@ -106,12 +64,12 @@ def test_double_matches_python(tmp_path, alg, structure, n):
 def test_float_error_against_double(tmp_path, alg, structure, n, capsys):
     q0 = MOTION.attitude(0.0)
     x = _increments() if alg == "rotvec" else _rates()[1]
-    e64, lib64 = _build(tmp_path / "d", algorithm=alg, structure=structure, subsamples=max(n, 1),
+    e64, lib64 = build(tmp_path / "d", algorithm=alg, structure=structure, subsamples=max(n, 1),
                         h=H)
-    e32, lib32 = _build(tmp_path / "f", algorithm=alg, structure=structure, subsamples=max(n, 1),
+    e32, lib32 = build(tmp_path / "f", algorithm=alg, structure=structure, subsamples=max(n, 1),
                         h=H, real="float")
-    d = _drive(e64, lib64, x, q0)
-    f = _drive(e32, lib32, x, q0)
+    d = drive(e64, lib64, x, q0)
+    f = drive(e32, lib32, x, q0)
     err = np.max(np.minimum(np.abs(f - d).max(axis=1), np.abs(f + d).max(axis=1)))
     with capsys.disabled():
         print(f"\n  float vs double, {alg} {structure}: max quaternion difference {err:.2e}")
@@ -148,21 +106,21 @@ def test_bad_export(tmp_path, kw, msg):
                                                       ("conventional", "eq6-printed", 3)])
 def test_other_coefficient_sets_match(tmp_path, structure, name, n):
     q0 = MOTION.attitude(0.0)
-    e, lib = _build(tmp_path, algorithm="rotvec", structure=structure, subsamples=n,
+    e, lib = build(tmp_path, algorithm="rotvec", structure=structure, subsamples=n,
                     coefficients=name, h=H)
     th = _increments()
     cs = coefficient_set(name, n)
     m = th.shape[0] - th.shape[0] % n
     py = (conventional(th[:m], cs, h=H, q0=q0) if structure == "conventional"
           else realtime(th, cs, h=H, q0=q0)).q
-    c = _drive(e, lib, th, q0)
+    c = drive(e, lib, th, q0)
     assert np.max(np.abs(c - py)) <= 1e-13
 
 
 def test_rate_paper_coefficients_match(tmp_path):
     q0 = MOTION.attitude(0.0)
-    e, lib = _build(tmp_path, algorithm="rate-three", structure="conventional",
+    e, lib = build(tmp_path, algorithm="rate-three", structure="conventional",
                     coefficients="paper", h=H)
     t, w = _rates()
     py = rate.rate_attitude(t, w, algorithm="rate-three", coefficients="paper", q0=q0).q
-    assert np.max(np.abs(_drive(e, lib, w, q0) - py)) <= 1e-13
+    assert np.max(np.abs(drive(e, lib, w, q0) - py)) <= 1e-13
