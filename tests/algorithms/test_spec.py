@@ -79,10 +79,10 @@ def test_invalid_specs_name_the_problem(text, msg):
 
 
 def test_registry_facts():
-    assert ALGORITHMS == ("rotvec", "rate-single", "rate-three", "rk4", "miller", "panov",
-                          "power")
+    assert ALGORITHMS == ("rotvec", "rate-single", "rate-three", "rk4", "rate-two", "miller",
+                          "panov", "power")
     assert set(STRUCTURES) == {"conventional", "realtime", "single-chain", "sliding"}
-    assert algorithms_taking("rate") == ("rate-single", "rate-three", "rk4")
+    assert algorithms_taking("rate") == ("rate-single", "rate-three", "rk4", "rate-two")
     assert REGISTRY["rotvec"].coefficient_names() == coefficient_set_names()
     h = 1e-3
     facts = {  # spec: (input kind, minimum samples, update period / h, drift order)

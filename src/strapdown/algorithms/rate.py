@@ -71,7 +71,7 @@ __all__ = [
 
 F = Fraction
 #: The rate-input families defined here, in registry order.
-RateAlgorithmName = Literal["rate-single", "rate-three", "rk4"]
+RateAlgorithmName = Literal["rate-single", "rate-three", "rk4", "rate-two"]
 #: Coefficient sets of the rate algorithms (:data:`~strapdown.algorithms.family.RateCoefficients`).
 COEFFICIENTS: tuple[RateCoefficients, ...] = get_args(RateCoefficients)
 #: RK4 step variants (:data:`~strapdown.algorithms.family.Rk4Step`).
@@ -485,8 +485,51 @@ class Rk4(Family):
                     span=2, end_off=2, lag=1, start_c=0.0, rk4=True)
 
 
+class RateTwo(WindowedRateFamily):
+    """``rate-two``: the designer's two-period algorithm, an update every 2 td.
+
+    Rates at 0, td, 2td; ``α = td/3 (ω₀ + 4ω₁ + ω₂)`` (Simpson), ``β = td² Σ k_ij ω_i × ω_j``
+    with the classical-coning optimum ``k = (3/10, 1/30, 3/10)`` for the pairs (0,1), (0,2),
+    (1,2): ``derive(rate_structure(2))``, quadrature error included. Drift
+    ``−37/15120 · a²Ω(Ωtd)⁶``, between rate-single (4th order) and rate-three (8th).
+    One coefficient set, ``derived``.
+    """
+
+    name = "rate-two"
+    reference = "strapdown designer: rate_structure(2) (Simpson quadrature, all pairs)"
+    _PAIRS = ((0, 1), (0, 2), (1, 2))
+    _WEIGHTS = (F(1, 3), F(4, 3), F(1, 3))
+    _SETS: ClassVar[dict[RateCoefficients, tuple[F, ...]]] = {
+        "derived": (F(3, 10), F(1, 30), F(3, 10))}
+    _DRIFT: ClassVar[dict[RateCoefficients, tuple[int, F]]] = {"derived": (6, F(37, 15120))}
+
+    def coefficient_names(self) -> tuple[RateCoefficients, ...]:
+        return tuple(self._SETS)
+
+    def windowed(self, spec: AlgorithmSpec) -> WindowedAlgorithm:
+        c = _coefficients(spec)
+        return WindowedAlgorithm("rate", 2, (0, 1, 2), self._WEIGHTS, self._PAIRS,
+                                 self._SETS[c], f"rate-two ({c})")
+
+    def min_samples(self, spec: AlgorithmSpec) -> int:
+        return 3
+
+    def update_period(self, spec: AlgorithmSpec, h: float) -> float:
+        return 2 * h
+
+    def drift_law(self, spec: AlgorithmSpec) -> DriftLaw:
+        return DriftLaw(*self._DRIFT[_coefficients(spec)])
+
+    def run_mp(self, spec: AlgorithmSpec, motion: Motion, *, h: float, samples: int,
+               digits: int) -> MpSolution:
+        from strapdown.algorithms.precision import run_windowed_mp
+
+        return run_windowed_mp(motion, self.windowed(spec), h=h, updates=(samples - 1) // 2,
+                               digits=digits)
+
+
 #: The families this module defines, in registry order.
-FAMILIES: tuple[Family, ...] = (RateSingle(), RateThree(), Rk4())
+FAMILIES: tuple[Family, ...] = (RateSingle(), RateThree(), Rk4(), RateTwo())
 #: Their names (:data:`RateAlgorithmName`), in registry order.
 ALGORITHMS: tuple[RateAlgorithmName, ...] = get_args(RateAlgorithmName)
 
