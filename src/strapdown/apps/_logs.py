@@ -25,8 +25,8 @@ from strapdown.algorithms.rate import UNIFORM_TOLERANCE, RateRecord, check_rate_
 from strapdown.io.files import atomic_path
 from strapdown.io.readers import ImuLog, UnitAction
 
-__all__ = ["JitterSummary", "PairedOutput", "check_finite", "output_with_sidecar",
-           "rate_records", "sidecar_path", "unit_action"]
+__all__ = ["JitterSummary", "PairedOutput", "check_finite", "log_segments",
+           "output_with_sidecar", "rate_records", "sidecar_path", "unit_action"]
 
 
 def unit_action(accept_unit_warning: bool) -> UnitAction:
@@ -82,6 +82,22 @@ def rate_records(path: Path, log: ImuLog, *, split: bool, min_samples: int,
     longest = max(recs, key=lambda r: r.t.size)
     return recs, JitterSummary(longest.td, max(r.jitter for r in recs),
                                any(r.resampled for r in recs), len(recs))
+
+
+def log_segments(path: Path, log: ImuLog, *, split: bool, min_samples: int,
+                 resample: bool) -> tuple[list[ImuLog], JitterSummary | None]:
+    """The log as the gap-free records the algorithms run on (one unless ``split``), each an
+    :class:`~strapdown.io.ImuLog`: rate logs on their uniform grid (:func:`rate_records`),
+    increment logs as read; with the rate logs' time base (None for increments)."""
+    if log.kind == "rate":
+        recs, base = rate_records(path, log, split=split, min_samples=min_samples,
+                                  resample=resample)
+        return [ImuLog(r.t, r.omega, "rate", r.td, units=log.units) for r in recs], base
+    if resample:
+        raise ValueError("--resample applies to rate logs (--rates) only")
+    cuts = log.segments() if split else [slice(0, log.t.size)]
+    return [ImuLog(log.t[c], log.data[c], "increment", log.h, units=log.units)
+            for c in cuts], None
 
 
 def check_finite(what: str, t: NDArray[np.float64], *arrays: NDArray[np.float64]) -> None:

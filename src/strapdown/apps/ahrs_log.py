@@ -1,37 +1,68 @@
-"""``strapdown ahrs``: the AHRS filter over a recording, written atomically.
+"""``strapdown ahrs``: the AHRS filter over a recording, written atomically with its metadata.
 
-Inputs: a BROAD ``.mat`` trial, or a CSV with a header naming time, gyro,
-accelerometer and (optionally) magnetometer columns — default
-``t,gx,gy,gz,ax,ay,az,mx,my,mz`` — in declared units (gyro ``rad/s`` or
-``deg/s``, accelerometer ``m/s2`` or ``g``; the magnetometer in any unit).
-Validation names the row of a NaN, a duplicated or non-monotonic time stamp
-and non-uniform sampling; a gyro whose magnitudes suggest deg/s declared as
-rad/s warns; an accelerometer whose norm is not about g (m/s² declared, g
-given) is an error. Without magnetometer columns the filter runs in its
-documented degraded mode: no heading (the gyro's integral from yaw 0), said
-on stderr and in the metadata.
+Inputs: a BROAD ``.mat`` trial (gyro rad/s, accelerometer m/s², magnetometer µT, as
+the format stores them), or a CSV with a header naming time, gyro, accelerometer and
+(optionally) magnetometer columns — found by name (time ``t``, ``time``, ``timestamp``
+…, axes ``gx,gy,gz``, ``ax,ay,az``, ``mx,my,mz`` and the spellings in
+:mod:`strapdown.io.readers`) or mapped with ``columns``. Units as ``run`` takes them:
+from the header (``gx[deg/s]``, ``ax[g]``, ``t[ms]``) or declared (gyro ``rad/s`` or
+``deg/s``, accelerometer ``m/s2`` or ``g``; the magnetometer in any unit); one the file
+contradicts, or none at all, is an error.
 
-Output: ``t,qw,qx,qy,qz`` (q_n_b, n = ENU by default or NED) and the
-estimated gyro bias ``bias_x,bias_y,bias_z`` (rad/s), as CSV or ``.npz``,
-plus ``OUT.meta.json`` (frame, heading observed, algorithm, measurement
-usage). The input is never overwritten.
+Validation names the row of a NaN, a duplicated or non-monotonic time stamp; jittered
+stamps run on their nominal period (or resampled, ``resample``; see
+:func:`strapdown.algorithms.rate.check_rate_record`); gaps fail or split the recording
+(``on_gap``: each segment filtered from the previous one's last attitude and bias). A
+gyro whose magnitudes suggest deg/s declared as rad/s is an error unless accepted; an
+accelerometer whose norm is not about g is an error. Without magnetometer columns the
+filter runs in its documented degraded mode: no heading (the gyro's integral from yaw
+0), said on stderr and in the metadata.
+
+A diverged filter — a non-finite or non-unit quaternion, a non-finite covariance, a gyro
+bias estimate above :data:`BIAS_LIMIT` rad/s — is an error at the output stage and
+nothing is written.
+
+Output: ``t,qw,qx,qy,qz`` (q_n_b, n = ENU by default or NED) and the estimated gyro bias
+``bias_x,bias_y,bias_z`` (rad/s) (+ ``segment`` when split), as CSV or ``.npz``, plus
+``OUT.meta.json`` (frame, heading observed, algorithm, measurement usage, units, time
+base and jitter, gaps, warnings, version), the two written together
+(:mod:`strapdown.apps._logs`). The input is never overwritten.
 """
 
 from __future__ import annotations
 
-import json
-from dataclasses import asdict, dataclass
+import dataclasses
+import warnings
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from strapdown.ahrs import AhrsConfig, AhrsResult, MeasurementFlag, ekf
+from strapdown.algorithms.rate import resample_uniform
+from strapdown.apps._logs import output_with_sidecar, rate_records, unit_action
 from strapdown.io import check_rows, csv_columns, warn_implausible_rate, write_attitude
-from strapdown.io.files import write_text
+from strapdown.io.readers import (
+    ACC_COLUMNS,
+    GYRO_COLUMNS,
+    MAG_COLUMNS,
+    ImuLog,
+    UnitAction,
+    default_columns,
+    time_scale,
+)
 
-__all__ = ["AhrsLog", "read_ahrs_log", "run_ahrs"]
+__all__ = ["ACC_UNITS", "BIAS_LIMIT", "DEFAULT_COLUMNS", "GYRO_UNITS", "AhrsLog", "read_ahrs_log",
+           "run_ahrs"]
 
+#: The column layout of an AHRS CSV written without a mapping (any recognised names work).
 DEFAULT_COLUMNS = ("t", "gx", "gy", "gz", "ax", "ay", "az", "mx", "my", "mz")
+#: Largest plausible gyro-bias estimate (rad/s, ≈ 57 °/s): beyond it the filter diverged.
+BIAS_LIMIT = 1.0
+GYRO_UNITS = ("rad/s", "deg/s")
+ACC_UNITS = ("m/s2", "g")
+_BROAD_UNITS = {"gyro": "rad/s", "accelerometer": "m/s2"}
 
 
 @dataclass(frozen=True)
@@ -42,70 +73,199 @@ class AhrsLog:
     gyro: np.ndarray
     acc: np.ndarray
     mag: np.ndarray | None
+    gyro_units: str = "rad/s"
+    acc_units: str = "m/s2"
+    gaps: list[int] = field(default_factory=list)
+    nominal_period: float | None = None
+
+
+def _unit(path: Path, what: str, option: str, allowed, declared, found, whose) -> str:
+    """The unit of one sensor: the file's (header, format) or the declared one."""
+    if found is not None:
+        if found not in allowed:
+            raise ValueError(f"{path}: the {what} is in {found!r}; use one of {allowed}")
+        if declared is not None and declared != found:
+            raise ValueError(f"{path}: declared {what} units {declared!r} contradict {whose[0]} "
+                             f"{found!r}{whose[1]}")
+        return found
+    if declared is None:
+        raise ValueError(f"{path}: no {what} units declared; pass {option} "
+                         f"({' or '.join(allowed)}) or write them in the header "
+                         f"(e.g. {'gx[deg/s]' if what == 'gyro' else 'ax[g]'})")
+    if declared not in allowed:
+        raise ValueError(f"{what} units must be one of {allowed}, got {declared!r}")
+    return declared
 
 
 def _csv(path: Path, columns):
-    raw, units, have_mag = csv_columns(path, columns[:7], optional=columns[7:10])
-    if units:
-        raise ValueError(f"{path}: units in the header ({units}) are not read for AHRS logs; "
-                         "name the columns plainly and declare --gyro-units/--acc-units")
-    m = raw[:, 7:10] if have_mag else None
-    return raw[:, 0], raw[:, 1:4], raw[:, 4:7], m
+    """``(t [s], gyro, acc, mag or None, header units of gyro and acc)``."""
+    if columns is None:
+        axes, mag = default_columns(path, [("gyro", GYRO_COLUMNS),
+                                           ("accelerometer", ACC_COLUMNS)], optional=MAG_COLUMNS)
+        columns = axes + mag
+    elif len(columns) not in (7, 10):
+        raise ValueError(f"columns must name t, 3 gyro, 3 accelerometer and optionally 3 "
+                         f"magnetometer columns, got {len(columns)}")
+    raw, units, have_mag = csv_columns(path, list(columns[:7]), optional=list(columns[7:10]))
+    found = {}
+    for what, cols in (("gyro", columns[1:4]), ("accelerometer", columns[4:7])):
+        us = {units[c] for c in cols if c in units}
+        if len(us) > 1:
+            raise ValueError(f"{path}: the header gives the {what} axes different units "
+                             f"{sorted(us)}")
+        found[what] = us.pop() if us else None
+    t = raw[:, 0] * time_scale(path, columns[0], units)
+    return t, raw[:, 1:4], raw[:, 4:7], raw[:, 7:10] if have_mag else None, found
 
 
-def read_ahrs_log(path, *, gyro_units: str = "rad/s", acc_units: str = "m/s2",
-                  columns=DEFAULT_COLUMNS, use_magnetometer: bool = True) -> AhrsLog:
+def read_ahrs_log(path, *, gyro_units: str | None = None, acc_units: str | None = None,
+                  columns=None, use_magnetometer: bool = True,
+                  sample_rate_hz: float | None = None, gap_tolerance: float = 1.5,
+                  unit_check: UnitAction = "warn") -> AhrsLog:
     """Read and validate a recording (see the module docstring)."""
     path = Path(path)
-    if gyro_units not in ("rad/s", "deg/s"):
-        raise ValueError(f"gyro units must be rad/s or deg/s, got {gyro_units!r}")
-    if acc_units not in ("m/s2", "g"):
-        raise ValueError(f"accelerometer units must be m/s2 or g, got {acc_units!r}")
     if not path.is_file():
         raise ValueError(f"{path}: no such file")
+    if not gap_tolerance > 1:
+        raise ValueError(f"gap_tolerance is in sample intervals and must exceed 1, got "
+                         f"{gap_tolerance}")
+    nominal = None
     if path.suffix.lower() == ".mat":
         from strapdown.io.broad import read_broad
 
         tr = read_broad(path)
+        if sample_rate_hz is not None and not np.isclose(1 / tr.h, sample_rate_hz, rtol=1e-6):
+            raise ValueError(f"{path}: the file states a sampling rate of {1 / tr.h:g} Hz, not "
+                             f"the {sample_rate_hz:g} Hz given")
         t, g, a, m = tr.t, tr.gyro, tr.acc, tr.mag
+        found = _BROAD_UNITS
+        whose = ("the file's", " (BROAD stores the gyro in rad/s, the accelerometer in m/s²)")
     elif path.suffix.lower() == ".csv":
-        if len(columns) not in (7, 10):
-            raise ValueError(f"columns must name t, 3 gyro, 3 accelerometer and optionally 3 "
-                             f"magnetometer columns, got {len(columns)}")
-        t, g, a, m = _csv(path, list(columns))
+        t, g, a, m, found = _csv(path, columns)
+        whose = ("the header's", "")
+        nominal = None if sample_rate_hz is None else 1.0 / sample_rate_hz
     else:
         raise ValueError(f"{path}: unsupported format (use a BROAD .mat or a CSV)")
+    gu = _unit(path, "gyro", "--gyro-units", GYRO_UNITS, gyro_units, found["gyro"], whose)
+    au = _unit(path, "accelerometer", "--acc-units", ACC_UNITS, acc_units,
+               found["accelerometer"], whose)
     check_rows(path, t, [("time", [t]), ("gyro", [g]), ("accelerometer", [a]),
                          *((("magnetometer", [m]),) if m is not None else ())])
-    if gyro_units == "deg/s":
+    if gu == "deg/s":
         g = np.radians(g)
-    if acc_units == "g":
+    if au == "g":
         a = a * 9.80665
-    warn_implausible_rate(path, g, gyro_units, suggestion="deg/s")
+    warn_implausible_rate(path, g, gu, suggestion="deg/s", action=unit_check)
     if m is not None and not np.any(m):
-        m = None
+        use_magnetometer = False
+    d = np.diff(t)
+    unit_h = nominal or float(np.median(d))
+    gaps = [int(i) + 2 for i in np.flatnonzero(d > gap_tolerance * unit_h)]
     return AhrsLog(t, np.ascontiguousarray(g), np.ascontiguousarray(a),
-                   None if (m is None or not use_magnetometer) else np.ascontiguousarray(m))
+                   None if (m is None or not use_magnetometer) else np.ascontiguousarray(m),
+                   gu, au, gaps, nominal)
+
+
+def _check_output(res: AhrsResult, gyro_units: str) -> None:
+    """Raise when the filter diverged (see the module docstring), naming where."""
+    bad = (~np.all(np.isfinite(res.q), axis=1)
+           | (np.abs(np.linalg.norm(res.q, axis=1) - 1.0) > 1e-6)
+           | ~np.all(np.isfinite(res.gyro_bias), axis=1)
+           | (np.linalg.norm(np.nan_to_num(res.gyro_bias, nan=np.inf), axis=1) > BIAS_LIMIT)
+           | ~np.all(np.isfinite(res.attitude_sigma), axis=1))
+    if np.any(bad):
+        i = int(np.argmax(bad))
+        raise ValueError(f"the filter diverged at output row {i + 1} (t = {float(res.t[i]):.6g} "
+                         f"s): quaternion {res.q[i].tolist()}, gyro bias "
+                         f"{res.gyro_bias[i].tolist()} rad/s (limit {BIAS_LIMIT:g}); nothing "
+                         f"written. Are the gyro units right (declared {gyro_units})?")
+
+
+def _merge(parts: list[AhrsResult], starts: list[int]) -> AhrsResult:
+    """One result from the segments': every per-output array concatenated, the sample
+    indices offset to the whole recording."""
+    if len(parts) == 1:
+        return parts[0]
+    cat: dict[str, Any] = {}
+    for f in dataclasses.fields(parts[0]):
+        first = getattr(parts[0], f.name)
+        if isinstance(first, np.ndarray) and first.shape[:1] == parts[0].t.shape:
+            cat[f.name] = np.concatenate([getattr(p, f.name) for p in parts])
+    cat["index"] = np.concatenate([p.index + s for p, s in zip(parts, starts, strict=True)])
+    return dataclasses.replace(parts[0], **cat)
+
+
+def _filter(imu: Path, log: AhrsLog, algorithm: str, frame: str, config: AhrsConfig | None,
+            split: bool, resample: bool):
+    """The filter over each gap-free segment; ``(result, segment per output, time base)``."""
+    glog = ImuLog(log.t, log.gyro, "rate", float(np.median(np.diff(log.t))), log.gaps, [],
+                  "rad/s", log.nominal_period)
+    recs, base = rate_records(imu, glog, split=split, min_samples=4, resample=resample)
+    cuts = glog.segments() if split else [slice(0, log.t.size)]
+    parts, seg = [], []
+    q0 = b0 = None
+    for k, (rec, c) in enumerate(zip(recs, cuts, strict=True)):
+        acc, mag = log.acc[c], None if log.mag is None else log.mag[c]
+        if rec.stamps is not None and rec.resampled:
+            acc = resample_uniform(rec.stamps, acc, rec.t)
+            mag = None if mag is None else resample_uniform(rec.stamps, mag, rec.t)
+        r = ekf(rec.t, rec.omega, acc, mag, algorithm=algorithm, config=config, frame=frame,
+                q0=q0, gyro_bias0=b0)
+        _check_output(r, log.gyro_units)
+        parts.append(r)
+        seg.append(np.full(r.t.size, float(k)))
+        q0, b0 = r.q[-1], r.gyro_bias[-1]
+    return _merge(parts, [c.start for c in cuts]), np.concatenate(seg), base
 
 
 def run_ahrs(imu, out, *, algorithm: str = "rate-single", frame: str = "ENU",
-             config: AhrsConfig | None = None, gyro_units: str = "rad/s",
-             acc_units: str = "m/s2", columns=DEFAULT_COLUMNS,
-             use_magnetometer: bool = True) -> tuple[AhrsResult, dict]:
-    """Filter a recording and write the attitude, biases and metadata atomically."""
+             config: AhrsConfig | None = None, gyro_units: str | None = None,
+             acc_units: str | None = None, columns=None, use_magnetometer: bool = True,
+             sample_rate_hz: float | None = None, on_gap: str = "report",
+             gap_tolerance: float = 1.5, resample: bool = False,
+             accept_unit_warning: bool = False) -> tuple[AhrsResult, dict[str, Any]]:
+    """Filter a recording and write the attitude, biases and metadata atomically.
+
+    ``on_gap``: ``"split"`` filters each gap-free segment from the previous one's last
+    attitude and bias (covariance reset; the motion during the gap is not observed);
+    ``"report"`` and ``"error"`` fail at a gap. ``resample`` interpolates jittered gyro,
+    accelerometer and magnetometer samples onto the uniform grid.
+    """
     imu, out = Path(imu), Path(out)
     if out.resolve() == imu.resolve():
         raise ValueError("--out must not be the input file")
     if out.suffix.lower() not in (".csv", ".npz"):
         raise ValueError(f"{out}: output must be .csv or .npz")
-    log = read_ahrs_log(imu, gyro_units=gyro_units, acc_units=acc_units, columns=columns,
-                        use_magnetometer=use_magnetometer)
-    res = ekf(log.t, log.gyro, log.acc, log.mag, algorithm=algorithm, config=config,
-              frame=frame)
-    write_attitude(out, res.t, res.q, extra={"bias_x": res.gyro_bias[:, 0],
-                                            "bias_y": res.gyro_bias[:, 1],
-                                            "bias_z": res.gyro_bias[:, 2]})
-    meta = {
+    if on_gap not in ("report", "error", "split"):
+        raise ValueError(f"on_gap must be report, error or split, got {on_gap!r}")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        log = read_ahrs_log(imu, gyro_units=gyro_units, acc_units=acc_units, columns=columns,
+                            use_magnetometer=use_magnetometer, sample_rate_hz=sample_rate_hz,
+                            gap_tolerance=gap_tolerance,
+                            unit_check=unit_action(accept_unit_warning))
+        if log.gaps and on_gap == "error":
+            r = log.gaps[0]
+            raise ValueError(f"{imu}: gap of {log.t[r - 1] - log.t[r - 2]:.6g} s before data "
+                             f"row {r}")
+        res, seg, base = _filter(imu, log, algorithm, frame, config, on_gap == "split",
+                                 resample)
+        extra = {"bias_x": res.gyro_bias[:, 0], "bias_y": res.gyro_bias[:, 1],
+                 "bias_z": res.gyro_bias[:, 2]}
+        if on_gap == "split":
+            extra["segment"] = seg
+        with output_with_sidecar(out) as paired:
+            write_attitude(paired.path, res.t, res.q, extra=extra)
+            paired.meta = _metadata(imu, log, res, algorithm, frame, base, on_gap,
+                                    [str(w.message) for w in caught])
+    return res, paired.meta
+
+
+def _metadata(imu: Path, log: AhrsLog, res: AhrsResult, algorithm: str, frame: str, base,
+              on_gap: str, caught: list[str]) -> dict[str, Any]:
+    from strapdown import __version__
+
+    return {
         "input": str(imu), "frame": frame, "quaternion": "q_n_b, Hamilton, scalar first",
         "heading_observed": res.heading_observed,
         "heading": ("magnetic" if res.config.declination_deg == 0 else "true")
@@ -115,7 +275,9 @@ def run_ahrs(imu, out, *, algorithm: str = "rate-single", frame: str = "ENU",
         "magnetometer_used": (res.fraction(MeasurementFlag.MAG_USED) if res.heading_observed
                               else 0.0),
         "rest_updates": res.fraction(MeasurementFlag.REST),
+        "gyro_units": log.gyro_units, "acc_units": log.acc_units, **base.to_dict(),
+        "time_base": base.describe(), "on_gap": on_gap,
+        "gaps": {"count": len(log.gaps), "first_rows": log.gaps[:100]},
+        "warnings": caught, "version": __version__,
         "config": asdict(res.config),
     }
-    write_text(out.with_name(out.name + ".meta.json"), json.dumps(meta, indent=2))
-    return res, meta

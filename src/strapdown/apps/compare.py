@@ -214,38 +214,70 @@ def _common_times(ta: NDArray[np.float64], tb: NDArray[np.float64], tol: float
     return j[ok].astype(np.intp), np.flatnonzero(ok).astype(np.intp)
 
 
-def _run_on_log(log, fields, q0):
+def _log_spec(fields) -> AlgorithmSpec:
     spec = AlgorithmSpec(**fields)
     if spec.family.stepped:
         raise ValueError(f"{spec.algorithm} runs on reference motions only (its input is the "
                          "Krylov model's increments at thirds or halves of a step); use rotvec "
                          "or a rate algorithm on a log")
-    return spec.run(log, q0=q0), spec.update_period(log.h)
+    return spec
+
+
+def _run_on_log(segments, fields, q0):
+    """Run one spec over the log's gap-free segments (each from the previous one's last
+    attitude); ``(solution, update period)``."""
+    spec = _log_spec(fields)
+    sols = []
+    for seg in segments:
+        sols.append(spec.run(seg, q0=q0))
+        q0 = sols[-1].q[-1]
+    sol = sols[0] if len(sols) == 1 else dataclasses.replace(
+        sols[0], t=np.concatenate([s.t for s in sols]), q=np.concatenate([s.q for s in sols]),
+        chain=np.concatenate([s.chain for s in sols]))
+    return sol, spec.update_period(segments[0].h)
 
 
 def compare_log(imu: str | os.PathLike[str], specs: Iterable[str], out: str | os.PathLike[str],
                 *, kind: InputKind, units: GyroUnit | None,
-                columns: Sequence[str] = ("t", "gx", "gy", "gz"),
+                columns: Sequence[str] | None = None,
                 sample_rate_hz: float | None = None, truth: str | os.PathLike[str] | None = None,
-                progress: Callable[[str], None] | None = None) -> list[AlgorithmRun]:
-    """Run every spec on one gyro log and compare them (see the module docstring)."""
+                progress: Callable[[str], None] | None = None, on_gap: str = "report",
+                gap_tolerance: float = 1.5, resample: bool = False,
+                accept_unit_warning: bool = False) -> list[AlgorithmRun]:
+    """Run every spec on one gyro log and compare them (see the module docstring).
+
+    The log is read as ``strapdown run`` reads it (:func:`strapdown.io.read_imu`; jittered
+    rate stamps on their nominal period or ``resample``-d; ``on_gap="split"`` runs every
+    spec over each gap-free segment from the previous one's last attitude; magnitudes that
+    suggest another unit are an error unless ``accept_unit_warning``).
+    """
+    from strapdown.apps._logs import log_segments, unit_action
     from strapdown.io import read_imu
 
     specs = list(specs)
     if not specs:
         raise ValueError("give at least one algorithm spec")
     fields = [parse_spec(s) for s in specs]
-    log = read_imu(imu, kind=kind, units=units, columns=columns, sample_rate_hz=sample_rate_hz)
-    tol = TIME_TOLERANCE * log.h
-    title = f"{Path(imu).name}: {log.t.size} {kind} samples at {1 / log.h:g} Hz"
+    if on_gap not in ("report", "error", "split"):
+        raise ValueError(f"on_gap must be report, error or split, got {on_gap!r}")
+    log = read_imu(imu, kind=kind, units=units, columns=columns, sample_rate_hz=sample_rate_hz,
+                   gap_tolerance=gap_tolerance, on_gap="error" if on_gap == "error" else "report",
+                   unit_check=unit_action(accept_unit_warning))
+    segments, base = log_segments(Path(imu), log, split=on_gap == "split", resample=resample,
+                                  min_samples=max(_log_spec(f).min_samples for f in fields))
+    h = segments[0].h
+    tol = TIME_TOLERANCE * h
+    title = f"{Path(imu).name}: {log.t.size} {kind} samples at {1 / h:g} Hz"
+    if base is not None and progress is not None:
+        progress(f"{imu}: {log.t.size} rate samples, {base.describe()}")
     if truth is None:
-        sols = [_run_on_log(log, f, None) for f in fields]
+        sols = [_run_on_log(segments, f, None) for f in fields]
         runs, what, ylabel, pairs = _against_reference(specs, sols, tol)
         _write(out, runs, title, what, progress, ylabel=ylabel, pairs=pairs)
         return runs
     t_ref, q_ref = _read_truth(truth)
     q0 = _truth_start(truth, t_ref, q_ref, log, tol)
-    sols = [_run_on_log(log, f, q0) for f in fields]
+    sols = [_run_on_log(segments, f, q0) for f in fields]
     name = Path(truth).name
     runs = []
     for spec, (sol, period) in zip(specs, sols, strict=True):

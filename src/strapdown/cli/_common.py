@@ -15,7 +15,8 @@ from collections.abc import Callable, Iterable
 from typing import TYPE_CHECKING, TypeVar
 
 if TYPE_CHECKING:
-    from strapdown.algorithms.family import AlgorithmName, Family
+    from strapdown.algorithms.family import Family
+    from strapdown.algorithms.spec import AlgorithmName
 
 __all__ = [
     "CommandParser",
@@ -145,7 +146,8 @@ def motion_args(p: argparse.ArgumentParser, rate_default: float | None = 10_000.
     g.add_argument("--spin-rate-dps", type=float, default=0.0, help="spin rate (deg/s)")
     rate_help = "gyro increment rate 1/h (Hz)"
     if rate_default is None:
-        rate_help += "; motions default to 10000, a log to its own time stamps"
+        rate_help += ("; motions default to 10000; with --imu the sensor's rate: the nominal "
+                      "period of jittered time stamps (default: from the stamps)")
     g.add_argument("--sample-rate-hz", type=float, default=rate_default, help=rate_help)
     g.add_argument("--duration", type=float, default=2.0, help="simulated time (s)")
 

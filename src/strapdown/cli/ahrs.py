@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from strapdown.cli._common import columns, say
+from strapdown.cli._common import columns, log_check_args, say
 
 __all__ = ["add_parser", "run"]
 
@@ -16,6 +16,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         help="attitude and heading from gyro, accelerometer and magnetometer (error-state EKF)",
         description="Run the AHRS filter over a recording (BROAD .mat or CSV with "
         "t,gx,gy,gz,ax,ay,az[,mx,my,mz]) and write t,qw,qx,qy,qz (q_n_b) and the gyro bias, "
+        "one row per input sample (the first: the initial attitude at the first time stamp), "
         "plus OUT.meta.json. Without magnetometer columns heading is not observed (said on "
         "stderr and in the metadata).")
     p.set_defaults(handler=run)
@@ -23,8 +24,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def _arguments(p: argparse.ArgumentParser) -> None:
-    from strapdown.apps.ahrs_log import DEFAULT_COLUMNS
-    from strapdown.io.readers import RATE_UNITS
+    from strapdown.apps.ahrs_log import ACC_UNITS, GYRO_UNITS
 
     p.add_argument("--imu", required=True, help="recording (.mat BROAD, .csv)")
     p.add_argument("--out", required=True, help="output .csv or .npz")
@@ -33,11 +33,20 @@ def _arguments(p: argparse.ArgumentParser) -> None:
                    "rate-three:structure=sliding, rk4, rotvec:N=3, ...")
     p.add_argument("--frame", choices=["ENU", "NED"], default="ENU",
                    help="reference frame n of q_n_b")
-    p.add_argument("--gyro-units", choices=RATE_UNITS, default="rad/s", help="gyro units")
-    p.add_argument("--acc-units", choices=["m/s2", "g"], default="m/s2",
-                   help="accelerometer units")
-    p.add_argument("--columns", default=",".join(DEFAULT_COLUMNS),
-                   help="CSV columns: time, gyro xyz, accelerometer xyz[, magnetometer xyz]")
+    p.add_argument("--gyro-units", choices=GYRO_UNITS, default=None,
+                   help="gyro units; required unless the file declares them: a CSV header "
+                   "(gx[deg/s]) or BROAD (rad/s); one the file contradicts is an error")
+    p.add_argument("--acc-units", choices=ACC_UNITS, default=None,
+                   help="accelerometer units; required unless the file declares them: a CSV "
+                   "header (ax[g]) or BROAD (m/s2)")
+    p.add_argument("--columns", default=None,
+                   help="CSV columns: time, gyro xyz, accelerometer xyz[, magnetometer xyz] "
+                   "(default: found in the header — time t, time, timestamp, t[ms] …; gx,gy,gz; "
+                   "ax,ay,az; mx,my,mz when present)")
+    p.add_argument("--sample-rate-hz", type=float, default=None,
+                   help="the sensor's sample rate (Hz): the nominal period of jittered time "
+                   "stamps (default: from the stamps)")
+    log_check_args(p, saturation=False)
     p.add_argument("--no-mag", action="store_true", help="ignore the magnetometer")
     p.add_argument("--no-gating", action="store_true",
                    help="accept every measurement (no innovation gating or disturbance checks)")
@@ -48,22 +57,24 @@ def _arguments(p: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Filter the recording, write attitude and metadata, report what was used."""
-    import warnings
-
     from strapdown.ahrs import AhrsConfig
     from strapdown.apps.ahrs_log import run_ahrs
 
     cfg = AhrsConfig(gating=not args.no_gating, declination_deg=args.declination_deg)
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        res, meta = run_ahrs(args.imu, args.out, algorithm=args.algorithm, frame=args.frame,
-                             config=cfg, gyro_units=args.gyro_units, acc_units=args.acc_units,
-                             columns=columns(args.columns), use_magnetometer=not args.no_mag)
-    for w in caught:
-        say(f"warning: {w.message}")
+    res, meta = run_ahrs(args.imu, args.out, algorithm=args.algorithm, frame=args.frame,
+                         config=cfg, gyro_units=args.gyro_units, acc_units=args.acc_units,
+                         columns=None if args.columns is None else columns(args.columns),
+                         use_magnetometer=not args.no_mag, sample_rate_hz=args.sample_rate_hz,
+                         on_gap=args.on_gap, gap_tolerance=args.gap_tolerance,
+                         resample=args.resample, accept_unit_warning=args.accept_unit_warning)
+    for w in meta["warnings"]:
+        say(f"warning: {w}")
+    if meta["gaps"]["count"]:
+        say(f"warning: {meta['gaps']['count']} gap(s) (split into segments), first at data row "
+            f"{meta['gaps']['first_rows'][0]}")
     if not res.heading_observed:
         say("warning: no magnetometer: heading is not observed (gyro integral from yaw 0)")
     print(f"wrote {args.out} ({meta['outputs']} attitudes, q_n_b with n = {args.frame}; "
           f"accelerometer used {meta['accelerometer_used']:.0%}, magnetometer "
-          f"{meta['magnetometer_used']:.0%}) and {args.out}.meta.json")
+          f"{meta['magnetometer_used']:.0%}; {meta['time_base']}) and {args.out}.meta.json")
     return 0

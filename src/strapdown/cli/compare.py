@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from strapdown.cli._common import columns, log_args, motion_args, say
+from strapdown.cli._common import columns, log_args, log_check_args, motion_args, say
 
 __all__ = ["add_parser", "run"]
 
@@ -31,6 +31,7 @@ def _arguments(p: argparse.ArgumentParser) -> None:
     motion_args(p, rate_default=None)
     log_args(p, imu_help="compare on this log instead of a motion", required=False,
              sample_rate=False)
+    log_check_args(p, saturation=False)
     p.add_argument("--truth", default=None,
                    help="log only: reference attitude file with t,qw,qx,qy,qz (CSV or .npz)")
     p.add_argument("--out", required=True, help="output directory")
@@ -41,8 +42,13 @@ def run(args: argparse.Namespace) -> int:
     from strapdown.apps import compare
 
     if args.imu is None:
-        if args.kind or args.truth or args.units:
-            raise ValueError("--rates/--increments, --units and --truth belong to --imu")
+        log_only = (args.kind or args.truth or args.units or args.columns or args.resample
+                    or args.accept_unit_warning or args.on_gap != "report"
+                    or args.gap_tolerance != 1.5)
+        if log_only:
+            raise ValueError("--rates/--increments, --units, --columns, --truth and the log "
+                             "checks (--on-gap, --gap-tolerance, --resample, "
+                             "--accept-unit-warning) belong to --imu")
         from strapdown.analysis.evaluate import EvaluationConfig
 
         base = EvaluationConfig(
@@ -54,10 +60,12 @@ def run(args: argparse.Namespace) -> int:
     else:
         if args.kind is None:
             raise ValueError("--imu needs --rates or --increments")
-        runs = compare.compare_log(args.imu, args.algorithms, args.out, kind=args.kind,
-                                   units=args.units, columns=columns(args.columns),
-                                   sample_rate_hz=args.sample_rate_hz, truth=args.truth,
-                                   progress=say)
+        runs = compare.compare_log(
+            args.imu, args.algorithms, args.out, kind=args.kind, units=args.units,
+            columns=None if args.columns is None else columns(args.columns),
+            sample_rate_hz=args.sample_rate_hz, truth=args.truth, progress=say,
+            on_gap=args.on_gap, gap_tolerance=args.gap_tolerance, resample=args.resample,
+            accept_unit_warning=args.accept_unit_warning)
     for r in runs:
         print(f"{r.label:40s} max {r.summary['max_error_rad']:.3e} rad  "
               f"rms {r.summary['rms_error_rad']:.3e} rad")

@@ -28,13 +28,16 @@ def _arguments(p: argparse.ArgumentParser) -> None:
                    help="the algorithm to generate")
     p.add_argument("--structure", choices=STRUCTURES, default="conventional",
                    help=structure_help(ALGORITHMS))
-    p.add_argument("--subsamples", type=int, default=3, help="N, subsamples per update (rotvec)")
+    p.add_argument("--subsamples", type=int, default=None,
+                   help="N, subsamples per update (rotvec only, default 3; an error for the "
+                   "other algorithms)")
     p.add_argument("--coefficients", default=None,
                    help="coefficient set; " + coefficients_help(ALGORITHMS))
     p.add_argument("--float", dest="real", choices=REALS, default="double",
                    help="C floating-point type of the state and the arithmetic")
-    p.add_argument("--sample-rate-hz", type=float, default=10_000.0,
-                   help="rate algorithms: 1/td, baked into the code")
+    p.add_argument("--sample-rate-hz", type=float, default=None,
+                   help="rate algorithms (required): the gyro's sample rate 1/td, baked into "
+                   "the code; an error for rotvec, whose code does not depend on it")
     p.add_argument("--name", default=None,
                    help="C identifier prefix (default: derived from the configuration, e.g. "
                    "sd_rotvec_conventional_n3)")
@@ -43,13 +46,28 @@ def _arguments(p: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Write the C files and print the operation counts."""
+    from strapdown.algorithms.spec import family
     from strapdown.codegen.export_c import export_c
 
-    if not args.sample_rate_hz > 0:
-        raise ValueError(f"sample rate must be positive, got {args.sample_rate_hz}")
+    fam = family(args.algorithm)
+    if args.subsamples is not None and "subsamples" not in fam.options:
+        raise ValueError(f"--subsamples does not apply to {args.algorithm} (only rotvec has "
+                         "subsamples per update)")
+    h = None
+    if fam.input_kind == "rate":
+        if args.sample_rate_hz is None:
+            raise ValueError(f"{args.algorithm} bakes the sample period td into the code: pass "
+                             "--sample-rate-hz (the gyro's rate, Hz)")
+        if not args.sample_rate_hz > 0:
+            raise ValueError(f"sample rate must be positive, got {args.sample_rate_hz}")
+        h = 1.0 / args.sample_rate_hz
+    elif args.sample_rate_hz is not None:
+        raise ValueError(f"--sample-rate-hz does not apply to {args.algorithm} (its input is "
+                         "increments; the generated code does not depend on the rate)")
     e = export_c(args.out, algorithm=args.algorithm, structure=args.structure,
-                 subsamples=args.subsamples, coefficients=args.coefficients, real=args.real,
-                 h=1.0 / args.sample_rate_hz, name=args.name)
+                 subsamples=3 if args.subsamples is None else args.subsamples,
+                 coefficients=args.coefficients, real=args.real, name=args.name,
+                 **({} if h is None else {"h": h}))
     print(f"wrote {args.out}/{e.name}.h and {e.name}.c")
     print("operations per update: " + ", ".join(f"{k} {v}" for k, v in e.ops.items()))
     return 0
