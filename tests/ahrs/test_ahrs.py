@@ -72,6 +72,23 @@ def test_ideal_sensors_track_exact_truth(alg):
     assert np.abs(r.gyro_bias).max() < 1e-4
 
 
+@pytest.mark.parametrize(("alg", "stride"), [("rate-single", 1), ("rate-three", 3),
+                                             ("rate-three:structure=sliding", 1), ("rk4", 2),
+                                             ("rotvec:N=3", 3)])
+def test_one_row_per_sample_the_first_the_initial_attitude(alg, stride):
+    h = 0.01
+    t = np.arange(101) * h
+    q, w, acc, mag = _imu(_motion(), t)
+    q0_ned = quat_multiply(Q_NED_ENU, q[0])
+    r = ekf(t, w, acc, mag, algorithm=alg, q0=q0_ned, frame="NED")
+    assert r.q.shape == (101, 4) and np.array_equal(r.t, t)
+    assert np.array_equal(r.index, np.arange(101))
+    assert np.allclose(r.q[0], q0_ned, rtol=0, atol=1e-15)
+    assert np.isnan(r.nis[0]).all() and r.flags[0] == 0 and not r.epoch[0]
+    assert np.array_equal(np.flatnonzero(r.epoch), np.arange(stride, 101, stride))
+    assert np.all(r.flags[~r.epoch] == 0) and r.fraction(Flag.ACC_USED) == 1.0
+
+
 def test_bias_is_estimated_at_rest_and_then_in_motion():
     h = 1 / 200
     t = np.arange(int(60 / h)) * h
@@ -245,6 +262,7 @@ def test_cli_ahrs_csv_roundtrip_and_degraded_mode(tmp_path, capsys):
                  "--acc-units", "g", "--out", str(out)]) == 0
     a = np.genfromtxt(out, delimiter=",", names=True)
     assert a.dtype.names == ("t", "qw", "qx", "qy", "qz", "bias_x", "bias_y", "bias_z")
+    assert a.size == t.size and a["t"][0] == t[0]  # one row per sample, the first at t[0]
     meta = json.loads((tmp_path / "att.csv.meta.json").read_text())
     assert meta["frame"] == "ENU" and meta["heading_observed"] is True
     # no magnetometer columns: heading not observed, said so
@@ -276,6 +294,21 @@ def test_cli_ahrs_csv_roundtrip_and_degraded_mode(tmp_path, capsys):
     assert exc.value.code == 2
     assert "NaN or infinity in the accelerometer at data row 12" in capsys.readouterr().err
     assert not (tmp_path / "x.csv").exists()
+
+
+@pytest.mark.skipif(BROAD is None, reason="BROAD data not found (set STRAPDOWN_BROAD)")
+def test_cli_ahrs_on_a_broad_trial_writes_one_row_per_sample(tmp_path):
+    from strapdown.cli import main
+    from strapdown.io.broad import read_broad
+
+    trial = BROAD / "01_undisturbed_slow_rotation_A.mat"
+    out = tmp_path / "att.npz"
+    assert main(["ahrs", "--imu", str(trial), "--out", str(out)]) == 0
+    n = read_broad(trial).t.size
+    with np.load(out) as a:
+        assert a["t"].shape == (n,) and a["qw"].shape == (n,)
+        assert a["t"][0] == 0.0
+    assert json.loads((tmp_path / "att.npz.meta.json").read_text())["outputs"] == n
 
 
 def test_accelerometer_bias_state(monkeypatch):

@@ -158,14 +158,15 @@ class Initial(NamedTuple):
 
 class Outputs(NamedTuple):
     """Output rows, one per epoch (allocated by the caller, at least as many as epochs):
-    q (m, 4), gyro_bias, accel, acc_bias (m, 3), index, flags (m,) int64, nis (m, 2)
-    (accelerometer, heading; NaN without an update), attitude_sigma (m, 3)."""
+    q (m, 4), gyro_bias, accel, acc_bias (m, 3), sample (the epoch's sample index), flags
+    (m,) int64, nis (m, 2) (accelerometer, heading; NaN without an update), attitude_sigma
+    (m, 3)."""
 
     q: np.ndarray
     gyro_bias: np.ndarray
     accel: np.ndarray
     acc_bias: np.ndarray
-    index: np.ndarray
+    sample: np.ndarray
     flags: np.ndarray
     nis: np.ndarray
     attitude_sigma: np.ndarray

@@ -215,36 +215,49 @@ class AhrsConfig:
 
 @dataclass(frozen=True)
 class AhrsResult:
-    """Filter output at every attitude update.
+    """Filter output: one row per input sample.
+
+    Row 0 is the initial state at the first time stamp (the initial attitude, bias
+    and covariance). A row where a filter epoch ended (:attr:`epoch`) holds the
+    estimate after that epoch's propagation and measurement updates; with an
+    algorithm whose update period spans several samples (``rate-three``, ``rk4``,
+    ``rotvec:N≥2``) the rows in between — and after the last epoch — hold the
+    attitude propagated from the last epoch by single-period steps on the
+    bias-corrected gyro (output only, causal: the filter state is not changed),
+    its bias and covariance held.
 
     Attributes
     ----------
-    t : ndarray (m,)
-        Output times (s).
-    index : ndarray (m,)
-        Sample index of each output.
-    q : ndarray (m, 4)
+    t : ndarray (n,)
+        The input time stamps (s).
+    index : ndarray (n,)
+        Sample index of each row (``arange(n)``).
+    epoch : ndarray (n,) of bool
+        True where a filter epoch ended at this sample.
+    q : ndarray (n, 4)
         q_n_b in :attr:`frame`.
     frame : {"ENU", "NED"}
     heading_observed : bool
         False without a magnetometer (heading is the gyro's integral).
-    gyro_bias : ndarray (m, 3)
+    gyro_bias : ndarray (n, 3)
         Estimated gyro bias, rad/s.
-    accel : ndarray (m, 3)
+    accel : ndarray (n, 3)
         Estimated manoeuvre acceleration in the body frame, m/s².
-    flags : ndarray (m,) of int
-        Bitwise or of :class:`~strapdown.ahrs.flags.MeasurementFlag` per output.
-    nis : ndarray (m, 2)
+    flags : ndarray (n,) of int
+        Bitwise or of :class:`~strapdown.ahrs.flags.MeasurementFlag` per row (0 where
+        no epoch ended).
+    nis : ndarray (n, 2)
         Accelerometer and heading NIS (NaN where there was no update).
-    attitude_sigma : ndarray (m, 3)
+    attitude_sigma : ndarray (n, 3)
         Standard deviation of δθ_b, rad.
     algorithm : str
-    acc_bias : ndarray (m, 3) or None
+    acc_bias : ndarray (n, 3) or None
         Estimated accelerometer bias, m/s² (with ``estimate_acc_bias``).
     """
 
     t: np.ndarray
     index: np.ndarray
+    epoch: np.ndarray
     q: np.ndarray
     frame: str
     heading_observed: bool
@@ -257,10 +270,20 @@ class AhrsResult:
     config: AhrsConfig = field(repr=False, default_factory=AhrsConfig)
     acc_bias: np.ndarray | None = None
 
+    def __post_init__(self):
+        n = self.t.shape[0]
+        for name in ("index", "epoch", "q", "gyro_bias", "accel", "flags", "nis",
+                     "attitude_sigma", "acc_bias"):
+            a = getattr(self, name)
+            if a is not None and a.shape[0] != n:
+                raise ValueError(f"AhrsResult.{name} has {a.shape[0]} rows, t has {n}: one "
+                                 "row per sample")
+
     def fraction(self, flag: MeasurementFlag | int) -> float:
-        """Share of outputs with any of ``flag``'s bits set (NaN without outputs), e.g.
+        """Share of filter epochs with any of ``flag``'s bits set (NaN without epochs), e.g.
         ``result.fraction(MeasurementFlag.MAG_USED)``."""
-        return float(np.mean((self.flags & flag) != 0)) if self.flags.size else math.nan
+        f = self.flags[self.epoch]
+        return float(np.mean((f & flag) != 0)) if f.size else math.nan
 
 
 def attitude_from_acc_mag(acc, mag=None, *, declination_deg: float = 0.0) -> np.ndarray:
@@ -284,7 +307,7 @@ def attitude_from_acc_mag(acc, mag=None, *, declination_deg: float = 0.0) -> np.
         if m.shape != (3,) or not np.all(np.isfinite(m)):
             raise ValueError(f"mag must be a finite (3,) vector, got {m!r}")
         mh = m - up * (m @ up)
-        if np.linalg.norm(mh) < 1e-6 * max(np.linalg.norm(m), 1e-300):
+        if np.linalg.norm(mh) < 1e-6 * max(float(np.linalg.norm(m)), 1e-300):
             raise ValueError("the magnetic field is vertical: heading is undefined")
         mnorth = mh / np.linalg.norm(mh)
         d = math.radians(declination_deg)
@@ -433,7 +456,7 @@ def _run(rec, acc, mag, prop: K.Propagation, window: K.Window, params: K.Params,
     x = rec.omega if prop.is_rate else 0.5 * h * (rec.omega[1:] + rec.omega[:-1])
     m = rec.t.size  # at most one output per sample
     out = K.Outputs(q=np.empty((m, 4)), gyro_bias=np.empty((m, 3)), accel=np.empty((m, 3)),
-                    acc_bias=np.empty((m, 3)), index=np.empty(m, np.int64),
+                    acc_bias=np.empty((m, 3)), sample=np.empty(m, np.int64),
                     flags=np.empty(m, np.int64), nis=np.empty((m, 2)),
                     attitude_sigma=np.empty((m, 3)))
     k = K.ekf_kernel(K.Sensors(np.ascontiguousarray(x), acc, mag, float(h)), prop, window,
@@ -441,16 +464,57 @@ def _run(rec, acc, mag, prop: K.Propagation, window: K.Window, params: K.Params,
     return out, k
 
 
-def _result(rec, out: K.Outputs, k: int, frame: str, have_mag: bool, algorithm: str,
-            cfg: AhrsConfig) -> AhrsResult:
-    """The first k output rows as an :class:`AhrsResult` in ``frame``."""
-    q = out.q[:k]
+def _fill_between_epochs(rec, q, bias, last):
+    """Rows of ``q`` (ENU) that are not epochs (``last[i] < i``): propagated from the row
+    before by one single-period step (``rate-single``, ``td/2 (ω₀ + ω₁) + c td² ω₀ × ω₁``
+    with the derived c = 1/6, see :mod:`strapdown.algorithms.rate`) on the gyro corrected
+    by the bias of the last epoch. In place."""
+    from strapdown.rotation.quaternion import quat_from_rotvec
+
+    n = rec.t.size
+    off = np.arange(n) - last  # samples since the last epoch (0 at epochs and row 0)
+    h = rec.td
+    for j in range(1, int(off.max()) + 1 if n else 1):  # a few samples at most
+        i = np.flatnonzero(off == j)
+        w0 = rec.omega[i - 1] - bias[i]
+        w1 = rec.omega[i] - bias[i]
+        phi = 0.5 * h * (w0 + w1) + h * h / 6.0 * np.cross(w0, w1)
+        q[i] = quat_multiply(q[i - 1], quat_from_rotvec(phi))
+
+
+def _result(rec, out: K.Outputs, k: int, init: K.Initial, frame: str, have_mag: bool,
+            algorithm: str, cfg: AhrsConfig) -> AhrsResult:
+    """One row per sample (see :class:`AhrsResult`): row 0 the initial state, the k epoch
+    rows of ``out`` at their samples, the rows between propagated
+    (:func:`_fill_between_epochs`), everything else held from the last epoch."""
+    n = rec.t.size
+    idx = out.sample[:k]
+    epoch = np.zeros(n, bool)
+    epoch[idx] = True
+    rows = np.arange(n)
+    last = np.maximum.accumulate(np.where(epoch, rows, 0))  # the last epoch row (or 0)
+
+    def per_sample(first, epochs):
+        a = np.empty((n, *np.shape(first)), np.asarray(epochs).dtype)
+        a[0] = first
+        a[idx] = epochs
+        return a[last]
+
+    sigma0 = np.sqrt(np.diag(init.P)[:3])
+    bias = per_sample(init.gyro_bias, out.gyro_bias[:k])
+    q = per_sample(init.q, out.q[:k])
+    _fill_between_epochs(rec, q, bias, last)
     if frame == "NED":
         q = quat_multiply(Q_NED_ENU, q)
-    idx = out.index[:k]
-    return AhrsResult(rec.t[idx], idx, q, frame, have_mag, out.gyro_bias[:k], out.accel[:k],
-                      out.flags[:k], out.nis[:k], out.attitude_sigma[:k], algorithm, cfg,
-                      out.acc_bias[:k] if cfg.estimate_acc_bias else None)
+    flags = np.zeros(n, np.int64)
+    flags[idx] = out.flags[:k]
+    nis = np.full((n, 2), np.nan)
+    nis[idx] = out.nis[:k]
+    return AhrsResult(rec.t, rows, epoch, q, frame, have_mag, bias,
+                      per_sample(np.zeros(3), out.accel[:k]), flags, nis,
+                      per_sample(sigma0, out.attitude_sigma[:k]), algorithm, cfg,
+                      per_sample(np.zeros(3), out.acc_bias[:k]) if cfg.estimate_acc_bias
+                      else None)
 
 
 def ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
@@ -488,6 +552,7 @@ def ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
     Returns
     -------
     AhrsResult
+        One row per input sample, the first the initial attitude at ``t[0]``.
 
     Raises
     ------
@@ -503,4 +568,4 @@ def ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
     prop, window = _propagation(_algorithm(algorithm))
     init = K.Initial(q_init, b0, _initial_covariance(cfg))
     out, k = _run(rec, acc, mag, prop, window, _params(cfg, ref, have_mag), init)
-    return _result(rec, out, k, frame, have_mag, algorithm, cfg)
+    return _result(rec, out, k, init, frame, have_mag, algorithm, cfg)
