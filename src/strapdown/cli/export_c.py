@@ -22,17 +22,19 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 def _arguments(p: argparse.ArgumentParser) -> None:
     from strapdown.algorithms.spec import STRUCTURES
-    from strapdown.codegen.export_c import ALGORITHMS, REALS
+    from strapdown.codegen.export_c import ALGORITHMS, ATTITUDE_ALGORITHMS, REALS
 
     p.add_argument("--algorithm", choices=ALGORITHMS, required=True,
-                   help="the algorithm to generate")
+                   help="the algorithm to generate (nav: the navigation update on the WGS-84 "
+                   "Earth with coning and sculling compensation)")
     p.add_argument("--structure", choices=STRUCTURES, default="conventional",
-                   help=structure_help(ALGORITHMS))
+                   help=structure_help(ATTITUDE_ALGORITHMS) + "; nav: conventional, single-chain")
     p.add_argument("--subsamples", type=int, default=None,
-                   help="N, subsamples per update (rotvec only, default 3; an error for the "
-                   "other algorithms)")
+                   help="N, subsamples per update (rotvec and nav only, default 3; an error for "
+                   "the other algorithms)")
     p.add_argument("--coefficients", default=None,
-                   help="coefficient set; " + coefficients_help(ALGORITHMS))
+                   help="coefficient set; " + coefficients_help(ATTITUDE_ALGORITHMS)
+                   + "; nav: table3 (default; its sculling set is the same)")
     p.add_argument("--float", dest="real", choices=REALS, default="double",
                    help="C floating-point type of the state and the arithmetic")
     p.add_argument("--sample-rate-hz", type=float, default=None,
@@ -47,8 +49,18 @@ def _arguments(p: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     """Write the C files and print the operation counts."""
     from strapdown.algorithms.spec import family
-    from strapdown.codegen.export_c import export_c
+    from strapdown.codegen.export_c import NAV_ALGORITHMS, export_c
 
+    if args.algorithm in NAV_ALGORITHMS:  # the sample interval is an argument of its init
+        if args.sample_rate_hz is not None:
+            raise ValueError("--sample-rate-hz does not apply to nav (its init takes the "
+                             "sample interval h)")
+        e = export_c(args.out, algorithm=args.algorithm, structure=args.structure,
+                     subsamples=3 if args.subsamples is None else args.subsamples,
+                     coefficients=args.coefficients, real=args.real, name=args.name)
+        print(f"wrote {args.out}/{e.name}.h and {e.name}.c")
+        print("operations per update: " + ", ".join(f"{k} {v}" for k, v in e.ops.items()))
+        return 0
     fam = family(args.algorithm)
     if args.subsamples is not None and "subsamples" not in fam.options:
         raise ValueError(f"--subsamples does not apply to {args.algorithm} (only rotvec has "

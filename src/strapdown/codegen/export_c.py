@@ -29,7 +29,8 @@ from strapdown.algorithms.rotvec import Rotvec
 from strapdown.algorithms.spec import REGISTRY, AlgorithmName, AlgorithmSpec, CoefficientName
 from strapdown.io.files import write_text
 
-__all__ = ["ALGORITHMS", "REALS", "CExport", "CReal", "export_c", "generate"]
+__all__ = ["ALGORITHMS", "ATTITUDE_ALGORITHMS", "NAV_ALGORITHMS", "REALS", "CExport", "CReal",
+           "ExportName", "NavExport", "export_c", "generate"]
 
 #: The C floating-point type of the generated code (``--float``).
 CReal = Literal["double", "float"]
@@ -156,10 +157,34 @@ def _phi_rotvec(terms, src, base_expr, n, real, comment=True):
     return "\n".join(lines)
 
 
-def generate(algorithm: AlgorithmName, *, structure: StructureName = "conventional",
+def _generate_nav(structure: StructureName, subsamples: int,
+                  coefficients: CoefficientName | None, real: CReal,
+                  name: str | None) -> CExport:
+    """The navigation update (:mod:`strapdown.codegen.nav_c`)."""
+    from strapdown.codegen.nav_c import generate_nav
+
+    if coefficients not in (None, "table3"):
+        raise ValueError("nav exports the designed coning and sculling sets only (table3)")
+    if real != "double":
+        raise ValueError("nav is exported in double only: a float latitude resolves 0.6 m")
+    name = name or f"sd_nav_{structure.replace('-', '_')}_n{subsamples}"
+    if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", name):
+        raise ValueError(f"name must be a C identifier, got {name!r}")
+    header, source, ops = generate_nav(structure, subsamples, name, _common("double"))
+    return CExport(name, header, source, ops, real)
+
+
+def generate(algorithm: ExportName, *, structure: StructureName = "conventional",
              subsamples: int = 3, coefficients: CoefficientName | None = None,
              real: CReal = "double", h: float = 1e-4, name: str | None = None) -> CExport:
-    """Generate the C for one configuration (see :func:`export_c`)."""
+    """Generate the C for one configuration (see :func:`export_c`).
+
+    ``algorithm="nav"``: the navigation update on the WGS-84 Earth with coning and sculling
+    compensation (:mod:`strapdown.codegen.nav_c`; its sample interval is an argument of the
+    generated init, ``h`` here is not used).
+    """
+    if algorithm == "nav":
+        return _generate_nav(structure, subsamples, coefficients, real, name)
     if algorithm not in _GENERATORS:
         raise ValueError(f"unknown algorithm {algorithm!r}; choose one of {', '.join(ALGORITHMS)}")
     spec = AlgorithmSpec(algorithm, structure=structure, subsamples=subsamples,
@@ -476,8 +501,14 @@ def _generator(family: Family) -> _Generator | None:
 #: C generator per exportable family, in registry order.
 _GENERATORS: dict[AlgorithmName, _Generator] = {
     name: g for name, fam in REGISTRY.items() if (g := _generator(fam)) is not None}
-#: Families ``export-c`` can generate, in registry order.
-ALGORITHMS: tuple[AlgorithmName, ...] = tuple(_GENERATORS)
+#: Attitude families ``export-c`` can generate, in registry order.
+ATTITUDE_ALGORITHMS: tuple[AlgorithmName, ...] = tuple(_GENERATORS)
+#: What ``export-c`` generates besides attitude: the navigation update with sculling.
+NavExport = Literal["nav"]
+NAV_ALGORITHMS: tuple[NavExport, ...] = get_args(NavExport)
+#: Everything ``export-c --algorithm`` takes: the attitude families, then ``nav``.
+ExportName = AlgorithmName | NavExport
+ALGORITHMS: tuple[ExportName, ...] = (*ATTITUDE_ALGORITHMS, *NAV_ALGORITHMS)
 
 
 def export_c(out: str | Path, **kwargs: Any) -> CExport:
