@@ -159,3 +159,21 @@ def test_a_failure_leaves_neither_file_and_a_stale_sidecar_never_survives(tmp_pa
         run_log(log, out, kind="rate", units="rad/s", algorithm="rk4")
     assert out.read_bytes() == second  # the previous pair is untouched
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a.csv", "a.csv.meta.json", "log.csv"]
+
+
+def test_sample_rate_applies_to_csv_logs(tmp_path, capsys):
+    # a rate CSV: the nominal period of its stamps, checked against them
+    log = _write(tmp_path / "log.csv", "t,gx,gy,gz", T, M.rate(T))
+    meta = run_log(log, tmp_path / "a.csv", kind="rate", units="rad/s", sample_rate_hz=1000.0)
+    assert meta["sample_period_s"] == 1e-3
+    _fails(capsys, ["run", "--imu", str(log), "--rates", "--units", "rad/s", "--sample-rate-hz",
+                    "1010", "--out", str(tmp_path / "b.csv")],
+           "the time stamps are not at the given sample period", tmp_path,
+           ["log.csv", "a.csv", "a.csv.meta.json"])
+    # an increment CSV: the increment interval
+    h = 2e-3
+    edges = np.arange(301) * h
+    inc = _write(tmp_path / "inc.csv", "t,gx,gy,gz", edges[1:], M.increments(edges))
+    meta = run_log(inc, tmp_path / "c.csv", kind="increment", units="rad",
+                   sample_rate_hz=500.0)
+    assert meta["sample_period_s"] == h and meta["update_period_s"] == pytest.approx(3 * h)

@@ -23,6 +23,7 @@ import numpy as np
 import pytest
 
 from strapdown.algorithms.rate import check_rate_record
+from strapdown.algorithms.spec import algorithms_taking
 from strapdown.cli import main
 from strapdown.rotation.dcm import dcm_from_quat
 from strapdown.rotation.error import attitude_error_angle
@@ -65,12 +66,12 @@ def _run_error(capsys, log, out, algorithm, *extra) -> tuple[float, str]:
     return float(attitude_error_angle(a[:, 1:5], truth).max()), capsys.readouterr().out
 
 
+#: Every rate family of the registry, plus the coefficient and structure variants.
+RATE_FAMILIES = algorithms_taking("rate")
 RUN_ALGORITHMS = {
-    "rate-single": ["--algorithm", "rate-single"],
+    **{name: ["--algorithm", name] for name in RATE_FAMILIES},
     "rate-single:coefficients=paper": ["--algorithm", "rate-single", "--coefficients", "paper"],
-    "rate-three": ["--algorithm", "rate-three"],
     "rate-three:structure=sliding": ["--algorithm", "rate-three", "--structure", "sliding"],
-    "rk4": ["--algorithm", "rk4"],
 }
 
 
@@ -81,7 +82,7 @@ def test_run_jittered_log(logs, capsys, name):
     clean, _ = _run_error(capsys, logs["clean"], d / "c.csv", alg)
     nominal, line = _run_error(capsys, logs["jittered"], d / "n.csv", alg)
     resampled, rline = _run_error(capsys, logs["jittered"], d / "r.csv", alg, "--resample")
-    assert clean < 1e-6  # the algorithms' own errors, 1.5e-10 … 6.9e-7 rad
+    assert clean < 1e-6  # the algorithms' own errors, 3e-11 … 6.9e-7 rad
     # nominal-period integration of rates taken at the jittered times: ω̇·e per sample,
     # ~1.5e-6 rad whatever the algorithm; beyond 2× wherever the algorithm is finer than that
     assert 5e-7 < nominal < 5e-6
@@ -113,8 +114,8 @@ def test_run_with_jittered_stamps_of_a_uniform_sensor(tmp_path, capsys):
     assert re.search(r"jitter ±0\.5\d? % of it", capsys.readouterr().out)
 
 
-COMPARE_SPECS = ["rate-single", "rate-single:coefficients=paper", "rate-three",
-                 "rate-three:coefficients=paper", "rate-three:structure=sliding", "rk4",
+COMPARE_SPECS = [*RATE_FAMILIES, "rate-single:coefficients=paper",
+                 "rate-three:coefficients=paper", "rate-three:structure=sliding",
                  "rk4:rk4_step=td-interp"]
 
 
@@ -148,7 +149,7 @@ def test_compare_jittered_log(logs, capsys):
         assert results["resampled"][spec] <= 1.01 * clean, spec
 
 
-AHRS_SPECS = ["rate-single", "rate-three", "rate-three:structure=sliding", "rk4"]
+AHRS_SPECS = [*RATE_FAMILIES, "rate-three:structure=sliding"]
 G_UP = np.array([0.0, 0.0, 9.80665])
 M_N = np.array([0.0, 20.0, -40.0])
 SLOW = SpinConing(math.radians(20.0), 2 * math.pi * 0.3, math.radians(30.0))

@@ -182,3 +182,15 @@ def test_compare_refuses_implausible_units_and_unsplit_gaps(tmp_path, capsys):
     _fails(capsys, ["compare", "--algorithms", "rk4", "--on-gap", "split", "--out",
                     str(tmp_path / "cmp3")], "belong to --imu", tmp_path,
            [*keep, "cmp2"])
+
+
+def test_ahrs_sample_rate_must_agree_with_the_stamps(tmp_path, capsys):
+    t, w, a, m = _imu(30.0)
+    log = _csv(tmp_path / "imu.csv", PLAIN, t, w, a, m)
+    units = ["--gyro-units", "rad/s", "--acc-units", "m/s2"]
+    _fails(capsys, ["ahrs", "--imu", log, *units, "--sample-rate-hz", "101", "--out",
+                    str(tmp_path / "a.csv")], "the time stamps are not at the given sample "
+           "period", tmp_path, ["imu.csv"])
+    assert main(["ahrs", "--imu", log, *units, "--sample-rate-hz", "100", "--out",
+                 str(tmp_path / "a.csv")]) == 0
+    assert json.loads((tmp_path / "a.csv.meta.json").read_text())["sample_period_s"] == H
