@@ -86,6 +86,7 @@ def test_unit_warning_is_an_error_unless_accepted(tmp_path, capsys):
     assert any("more likely in degrees" in w for w in meta["warnings"])
 
 
+@pytest.mark.filterwarnings("ignore::RuntimeWarning")  # 1e300 overflows on purpose
 def test_non_finite_result_fails_and_writes_nothing(tmp_path, capsys):
     # 1e300 rad/s overflows the RK4 step: the attitude is inf/NaN from the first update on
     log = _write(tmp_path / "log.csv", "t,gx,gy,gz", T[:20], np.tile([1e300, 0, 0], (20, 1)))

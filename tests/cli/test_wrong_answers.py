@@ -194,3 +194,13 @@ def test_ahrs_sample_rate_must_agree_with_the_stamps(tmp_path, capsys):
     assert main(["ahrs", "--imu", log, *units, "--sample-rate-hz", "100", "--out",
                  str(tmp_path / "a.csv")]) == 0
     assert json.loads((tmp_path / "a.csv.meta.json").read_text())["sample_period_s"] == H
+
+
+@pytest.mark.filterwarnings("ignore::RuntimeWarning")  # 1e300 overflows on purpose
+def test_compare_refuses_a_non_finite_attitude(tmp_path, capsys):
+    t = np.arange(20) / 1000.0
+    log = _csv(tmp_path / "log.csv", "t,gx,gy,gz", t, np.tile([1e300, 0, 0], (20, 1)))
+    _fails(capsys, ["compare", "--imu", log, "--rates", "--units", "rad/s",
+                    "--accept-unit-warning", "--algorithms", "rk4", "--out",
+                    str(tmp_path / "cmp")],
+           "the rk4 attitude is NaN or infinite from output row 2", tmp_path, ["log.csv"])

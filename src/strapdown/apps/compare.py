@@ -234,6 +234,9 @@ def _run_on_log(segments, fields, q0):
     sol = sols[0] if len(sols) == 1 else dataclasses.replace(
         sols[0], t=np.concatenate([s.t for s in sols]), q=np.concatenate([s.q for s in sols]),
         chain=np.concatenate([s.chain for s in sols]))
+    from strapdown.apps._logs import check_finite
+
+    check_finite(f"the {spec} attitude", sol.t, sol.q)
     return sol, spec.update_period(segments[0].h)
 
 
@@ -268,11 +271,15 @@ def compare_log(imu: str | os.PathLike[str], specs: Iterable[str], out: str | os
     h = segments[0].h
     tol = TIME_TOLERANCE * h
     title = f"{Path(imu).name}: {log.t.size} {kind} samples at {1 / h:g} Hz"
-    if base is not None and progress is not None:
-        progress(f"{imu}: {log.t.size} rate samples, {base.describe()}")
+
+    def time_base() -> None:  # said once every algorithm has run, before anything is written
+        if base is not None and progress is not None:
+            progress(f"{imu}: {log.t.size} rate samples, {base.describe()}")
+
     if truth is None:
         sols = [_run_on_log(segments, f, None) for f in fields]
         runs, what, ylabel, pairs = _against_reference(specs, sols, tol)
+        time_base()
         _write(out, runs, title, what, progress, ylabel=ylabel, pairs=pairs)
         return runs
     t_ref, q_ref = _read_truth(truth)
@@ -287,6 +294,7 @@ def compare_log(imu: str | os.PathLike[str], specs: Iterable[str], out: str | os
         runs.append(AlgorithmRun(spec, t, ang, _summary_row(
             spec, t, ang, period, {"compared_outputs": int(t.size),
                                    "reference": f"{name} ({where})"}), _chains(sol.chain)))
+    time_base()
     _write(out, runs, title, f"error against {name}", progress,
            ylabel=f"attitude error against {name} (rad)")
     return runs
