@@ -29,7 +29,8 @@ samples ``ω_k`` at ``t_k = t_0 + k·td``:
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import functools
+from dataclasses import dataclass, field
 from fractions import Fraction
 from typing import TYPE_CHECKING, Any, ClassVar, Literal, get_args
 
@@ -104,7 +105,8 @@ class RateRecord:
         Nominal sample period (s).
     jitter : float
         Largest deviation of the time stamps from the best-fit uniform grid of period
-        ``td``, in periods (0.005: ±0.5 % of td).
+        ``td``, in periods (0.005: ±0.5 % of td); for uniform stamps measured when first
+        asked for (an O(n) pass the algorithms do not need).
     stamps : ndarray (n_stamps,) or None
         The time stamps as given when ``t`` is the nominal grid (None: ``t`` is them).
     resampled : bool
@@ -114,9 +116,16 @@ class RateRecord:
     t: NDArray[np.float64]
     omega: NDArray[np.float64]
     td: float
-    jitter: float = 0.0
     stamps: NDArray[np.float64] | None = None
     resampled: bool = False
+    measured_jitter: float | None = field(default=None, repr=False)
+
+    @functools.cached_property
+    def jitter(self) -> float:
+        """See the class docstring."""
+        if self.measured_jitter is not None:
+            return self.measured_jitter
+        return _grid_fit(self.t if self.stamps is None else self.stamps, self.td)[1]
 
 
 def _checked_arrays(stamps: ArrayLike, omega: ArrayLike, min_samples: int
@@ -232,10 +241,10 @@ def check_rate_record(t: ArrayLike, omega: ArrayLike, *, min_samples: int = 2,
     if td is None:
         td_end = float((ts[-1] - ts[0]) / (ts.size - 1))  # nominal interval: O(n), no sort
         if not np.any(np.abs(d - td_end) > UNIFORM_TOLERANCE * td_end):
-            return RateRecord(ts, w, td_end, _grid_fit(ts, td_end)[1])
+            return RateRecord(ts, w, td_end)
         med = float(np.median(d))
         if not np.any(np.abs(d - med) > UNIFORM_TOLERANCE * med):
-            return RateRecord(ts, w, med, _grid_fit(ts, med)[1])
+            return RateRecord(ts, w, med)
     elif not td > 0 or not np.isfinite(td):
         raise ValueError(f"the sample period must be positive and finite, got {td!r}")
     period, jitter = _grid_fit(ts, None if td is None else float(td))
@@ -247,14 +256,14 @@ def check_rate_record(t: ArrayLike, omega: ArrayLike, *, min_samples: int = 2,
         raise _non_uniform(d, jitter, jitter_tolerance)
     if not resample:
         grid = ts[0] + np.arange(ts.size) * period
-        return RateRecord(grid, w, period, jitter, stamps=ts)
+        return RateRecord(grid, w, period, stamps=ts, measured_jitter=jitter)
     m = min(ts.size, int(np.floor((ts[-1] - ts[0]) / period * (1 + 1e-12))) + 1)
     if m < min_samples:
         raise ValueError(f"the resampled record has {m} samples; this algorithm needs at least "
                          f"{min_samples}")
     grid = ts[0] + np.arange(m) * period
-    return RateRecord(grid, resample_uniform(ts, w, grid), period, jitter, stamps=ts,
-                      resampled=True)
+    return RateRecord(grid, resample_uniform(ts, w, grid), period, stamps=ts,
+                      resampled=True, measured_jitter=jitter)
 
 
 def single_period_algorithm(coefficients: RateCoefficients = "derived") -> WindowedAlgorithm:
