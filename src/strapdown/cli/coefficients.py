@@ -38,6 +38,11 @@ def _arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--ignore-quadrature", action="store_true",
                    help="rate input: fit β only, ignoring the α quadrature error (shows what "
                    "such a derivation claims; the true drift is printed beside it)")
+    p.add_argument("--triple", action="store_true",
+                   help="add the triple cross products θ_N×(θ_(N−m)×θ_N) (single chain: "
+                   "θ_k×(θ_(k−m)×θ_k)) and cancel the a⁴ drift too, order by order in Ωh "
+                   "(the finite-amplitude sets; increment forms cross-with-last, lag, all-pairs "
+                   "and single-chain, target coning)")
     json_arg(p)
 
 
@@ -46,6 +51,8 @@ def run(args: argparse.Namespace) -> int:
     from strapdown.design import classical_coning_drift, derive, structure_by_name
 
     st = structure_by_name(args.form, args.subsamples, previous=args.previous)
+    if args.triple:
+        return _run_triple(args, st)
     d = derive(st, target=args.target, rule=args.rule, quadrature=not args.ignore_quadrature)
     rec = d.to_dict()
     true_drift = None
@@ -72,6 +79,38 @@ def run(args: argparse.Namespace) -> int:
     if true_drift is not None:
         order, const = true_drift
         lines.append(f"true drift    {_law(const, order)} (with the quadrature error)")
+    print("\n".join(lines))
+    return 0
+
+
+_TRIPLE_FORMS = ("cross-with-last", "lag", "all-pairs", "single-chain")
+
+
+def _run_triple(args: argparse.Namespace, st) -> int:
+    """``--triple``: the finite-amplitude design (pairs for a², triple terms for a⁴)."""
+    from strapdown.design.finite_amplitude import derive_triple, with_last_triples
+
+    if args.form not in _TRIPLE_FORMS:
+        raise ValueError(f"--triple applies to the forms {', '.join(_TRIPLE_FORMS)}, "
+                         f"not {args.form!r}")
+    if args.target != "coning" or args.ignore_quadrature or args.subsamples < 2:
+        raise ValueError("--triple designs for classical coning (--target coning) with N ≥ 2")
+    d = derive_triple(with_last_triples(st))
+    rec = d.to_dict()
+    if args.json:
+        print_json(rec)
+        return 0
+    names = rec["terms"] + rec["triple_terms"]
+    width = max(len(t) for t in names)
+    lines = [f"form          {rec['form']} ({rec['input']} input)",
+             f"target        coning in a² and a⁴ (free coefficients settled by {rec['rule']}, "
+             "triple terms by min-norm)"]
+    for term, frac, dec in zip(names, rec["coefficients"] + rec["triple_coefficients"],
+                               rec["decimals"] + rec["triple_decimals"], strict=True):
+        lines.append(f"  {term:{width}s}  {frac:>14s}  {dec: .17g}")
+    laws = [_law(c, q, f"a{'²⁴⁶'[p // 2 - 1]}Ω") for p, q, c in d.amplitude_law]
+    lines.append(f"drift         {'  '.join(laws)} about the cone axis (leading term of each "
+                 "power of a)")
     print("\n".join(lines))
     return 0
 

@@ -137,6 +137,10 @@ class Structure:
         The unknowns: each is a list of (pair index, multiplier).
     n : int
         The N the structure is named after.
+    triples : tuple of (int, int, int)
+        Node indices ``(m, i, j)``, ``i`` earlier than ``j``: the triple cross products
+        ``s_m × (s_i × s_j)`` the correction may use (increment input; designed by
+        :func:`strapdown.design.finite_amplitude.derive_triple`). Empty by default.
     """
 
     name: str
@@ -147,6 +151,7 @@ class Structure:
     pairs: tuple[tuple[int, int], ...]
     groups: tuple[tuple[tuple[int, Fraction], ...], ...]
     n: int
+    triples: tuple[tuple[int, int, int], ...] = ()
 
     def __post_init__(self):
         if self.input not in INPUT_KINDS:
@@ -158,10 +163,21 @@ class Structure:
                 raise ValueError(f"pair {(i, j)} indexes outside the {len(self.nodes)} nodes")
             if not self.nodes[i] < self.nodes[j]:
                 raise ValueError(f"pair {(i, j)}: the first node must be the earlier one")
+        for m, i, j in self.triples:
+            if self.input != "increment":
+                raise ValueError("triple cross products are defined for increment input only")
+            if not all(0 <= k < len(self.nodes) for k in (m, i, j)) or not i < j:
+                raise ValueError(f"triple {(m, i, j)}: indices must lie among the "
+                                 f"{len(self.nodes)} nodes with i < j")
 
     def term_names(self) -> tuple[str, ...]:
         """``"θ1×θ3"``-style names of the cross products, in pair order."""
         return tuple(f"{self._node_name(i)}×{self._node_name(j)}" for i, j in self.pairs)
+
+    def triple_names(self) -> tuple[str, ...]:
+        """``"θ3×(θ1×θ3)"``-style names of the triple cross products, in order."""
+        nm = self._node_name
+        return tuple(f"{nm(m)}×({nm(i)}×{nm(j)})" for m, i, j in self.triples)
 
     def _node_name(self, i: int) -> str:
         s = self.nodes[i]
@@ -512,6 +528,11 @@ class Design:
         Whether the rate-input α quadrature error was part of the derivation.
     conditions : int
         Number of independent conditions the target imposed and met.
+    triple_coefficients : tuple of Fraction
+        One per ``structure.triples`` (empty without triple terms).
+    amplitude_law : tuple of (int, int, Fraction)
+        Finite-amplitude designs only: ``(p, q, c)`` per power of ``a``, the leading terms of
+        drift ``= −Σ c a^p Ω (Ωh)^q`` (:func:`strapdown.design.finite_amplitude.drift_series`).
     """
 
     structure: Structure
@@ -522,6 +543,8 @@ class Design:
     drift_constant: Fraction | None
     quadrature_included: bool
     conditions: int
+    triple_coefficients: tuple[Fraction, ...] = ()
+    amplitude_law: tuple[tuple[int, int, Fraction], ...] = ()
 
     @property
     def terms(self) -> tuple[str, ...]:
@@ -561,8 +584,10 @@ class Design:
                                  f"{st.name} ({self.target})")
 
     def to_dict(self) -> dict[str, Any]:
-        """The documented JSON record of ``strapdown coefficients``."""
-        return {
+        """The documented JSON record of ``strapdown coefficients`` (with triple terms: also
+        ``triple_terms``, ``triple_coefficients``, ``triple_decimals`` and ``amplitude_law``,
+        a list of {``a_power``, ``order``, ``constant``})."""
+        rec: dict[str, Any] = {
             "form": self.structure.name,
             "input": self.structure.input,
             "target": self.target,
@@ -576,6 +601,15 @@ class Design:
                           "drift about the cone axis = −drift_constant · a²Ω(Ωh)^order"),
             "quadrature_included": self.quadrature_included,
         }
+        if self.structure.triples:
+            rec["triple_terms"] = list(self.structure.triple_names())
+            rec["triple_coefficients"] = [_fs(c) for c in self.triple_coefficients]
+            rec["triple_decimals"] = [float(c) for c in self.triple_coefficients]
+            rec["amplitude_law"] = [{"a_power": p, "order": q, "constant": _fs(c)}
+                                    for p, q, c in self.amplitude_law]
+            rec["drift_law"] = ("drift about the cone axis = −Σ constant · a^a_power Ω "
+                                "(Ωh)^order (amplitude_law)")
+        return rec
 
 
 _SCULLING_LAW = ("rectified velocity error rate along the axis normal to both vibrations = "

@@ -1,0 +1,331 @@
+"""Coning coefficients that keep their order at finite cone amplitude: triple cross products.
+
+The classical-coning drift of a rotation-vector algorithm is a function of two small
+parameters, the half-cone angle ``a`` and ``x = Ωh``. Li & Zhang (2017) Table 3 (and every
+published set) cancel only its ``a²`` part; at ``a = 1°`` the ``a⁴`` part, which comes from
+the Bortz terms the pair form neglects, dominates for N ≥ 3 (``strapdown reproduce li2017``).
+Triple cross products ``θ_m × (θ_i × θ_j)`` are ``O(a³)`` in the rotation vector, so they
+leave the ``a²`` drift unchanged and shift the ``a⁴`` drift linearly: with the pair
+coefficients of the ``a²`` design fixed, the ``a⁴`` conditions, order by order in ``x``,
+are a linear system for the triple coefficients.
+
+The drift series
+----------------
+Under classical coning every update's rotation vector is the first one's turned about the
+cone axis by ``ΩT`` (``T`` the update period), so the error after ``k`` updates is
+``q_a (E ρ)^k q_a⁻¹ ρ^{−k}`` with ``E = exp(φ_0)``, ``ρ = exp(x̂ ΩT/2)``, ``q_a`` the
+initial tilt. At whole cone periods that is a rotation by ``k Δ`` about the axis ``n`` of
+``q_a E ρ q_a⁻¹``, ``Δ = ψ − ΩT`` with ``ψ`` the rotation angle of ``E ρ``: the drift about
+the cone axis is exactly ``Δ n_x / T`` (the exact response, evaluated in arbitrary precision
+by :mod:`strapdown.analysis.frequency_response`). :func:`drift_series` expands it as a
+double power series in ``a`` and ``x`` with exact rational coefficients (gmpy2 ``mpq``):
+increments from the closed form of the classical-coning motion (Li & Zhang (2017) eq. 7),
+``φ`` with its pair and triple terms, the exponential map, ``E ρ`` and
+``2 atan(tan(ψ/2 − ΩT/2))``, every step a truncated bivariate series.
+
+Result (N = 3 … 6, both structures; :func:`derive_triple`): with the triple terms
+``τ_m θ_N × (θ_{N−m} × θ_N)`` (single chain: ``θ_k × (θ_{k−m} × θ_k)``), m = 1 … N−1, the
+``a⁴`` drift is cancelled through the order of the ``a²`` law, ``x^{2N}``, so the drift is
+``−c₂ a²Ω x^{2N} − c₄ a⁴Ω x^{2N+2} − c₆ a⁶Ω x^6 − …`` (constants in
+:attr:`strapdown.design.Design.amplitude_law`). The ``a⁶ x⁴`` term vanishes with the
+``a⁴ x⁴`` term; the ``a⁶ x⁶`` term remains (it is quadratic in the triple coefficients, so
+this linear design cannot remove it) and dominates the conventional N = 5, 6 sets at small
+``x``, where the drift is far below the float64 floor.
+"""
+
+from __future__ import annotations
+
+import functools
+from collections.abc import Sequence
+from dataclasses import replace
+from fractions import Fraction
+from math import factorial
+
+import sympy as sp
+from gmpy2 import mpq
+
+from strapdown.design.designer import Design, Structure, derive
+
+__all__ = ["A_ORDER", "derive_triple", "drift_series", "leading_terms", "with_last_triples"]
+
+#: Highest power of ``a`` carried by :func:`drift_series`.
+A_ORDER = 6
+
+_Series = list[list[mpq]]  # s[p][q]: coefficient of a^p x^q
+
+
+class _Bivariate:
+    """Truncated bivariate power series in ``a`` (degree ≤ pa) and ``x`` (degree ≤ qx)."""
+
+    def __init__(self, pa: int, qx: int):
+        self.pa, self.qx = pa, qx
+
+    def zero(self) -> _Series:
+        return [[mpq(0)] * (self.qx + 1) for _ in range(self.pa + 1)]
+
+    def const(self, c) -> _Series:
+        z = self.zero()
+        z[0][0] = mpq(c)
+        return z
+
+    def add(self, *ss: _Series) -> _Series:
+        z = self.zero()
+        for s in ss:
+            for p in range(self.pa + 1):
+                zp, sp_ = z[p], s[p]
+                for q in range(self.qx + 1):
+                    zp[q] += sp_[q]
+        return z
+
+    def scale(self, s: _Series, c) -> _Series:
+        c = mpq(c)
+        return [[c * v for v in row] for row in s]
+
+    def mul(self, s: _Series, t: _Series) -> _Series:
+        z = self.zero()
+        for p1 in range(self.pa + 1):
+            for q1, v1 in enumerate(s[p1]):
+                if not v1:
+                    continue
+                for p2 in range(self.pa + 1 - p1):
+                    r2, zr = t[p2], z[p1 + p2]
+                    for q2 in range(self.qx + 1 - q1):
+                        if r2[q2]:
+                            zr[q1 + q2] += v1 * r2[q2]
+        return z
+
+    def xshift(self, s: _Series, k: int) -> _Series:
+        """Multiply by ``x^k``; a negative ``k`` divides exactly (checked)."""
+        z = self.zero()
+        for p in range(self.pa + 1):
+            for q, v in enumerate(s[p]):
+                if v:
+                    if q + k < 0:
+                        raise ArithmeticError("series not divisible by the power of x")
+                    if q + k <= self.qx:
+                        z[p][q + k] = v
+        return z
+
+    def _graded(self):
+        return sorted(((p, q) for p in range(self.pa + 1) for q in range(self.qx + 1)),
+                      key=lambda t: (t[0] + t[1], t))
+
+    def inv(self, s: _Series) -> _Series:
+        """``1/s`` (``s`` with a non-zero constant term)."""
+        y = self.zero()
+        nz = [(p, q) for p in range(self.pa + 1) for q in range(self.qx + 1)
+              if s[p][q] and (p, q) != (0, 0)]
+        for p, q in self._graded():
+            if (p, q) == (0, 0):
+                y[0][0] = 1 / s[0][0]
+                continue
+            acc = sum((s[p1][q1] * y[p - p1][q - q1] for p1, q1 in nz if p1 <= p and q1 <= q),
+                      mpq(0))
+            y[p][q] = -acc / s[0][0]
+        return y
+
+    def sqrt(self, s: _Series, root: mpq) -> _Series:
+        """``√s`` with constant term ``root`` (``root² = s₀₀``)."""
+        if root * root != s[0][0]:
+            raise ArithmeticError("the constant term is not the square of the given root")
+        y = self.zero()
+        y[0][0] = root
+        for p, q in self._graded():
+            if (p, q) == (0, 0):
+                continue
+            acc = mpq(0)
+            for p1 in range(p + 1):
+                for q1 in range(q + 1):
+                    if (p1, q1) not in ((0, 0), (p, q)) and y[p1][q1]:
+                        acc += y[p1][q1] * y[p - p1][q - q1]
+            y[p][q] = (s[p][q] - acc) / (2 * root)
+        return y
+
+    def trig_a(self, cosine: bool) -> _Series:
+        z = self.zero()
+        for k in range(0 if cosine else 1, self.pa + 1, 2):
+            z[k][0] = mpq((-1) ** (k // 2), factorial(k))
+        return z
+
+    def trig_x(self, c, cosine: bool) -> _Series:
+        z = self.zero()
+        c = mpq(c)
+        for k in range(0 if cosine else 1, self.qx + 1, 2):
+            z[0][k] = mpq((-1) ** (k // 2)) * c**k / factorial(k)
+        return z
+
+    def cross(self, u, v):
+        m, a = self.mul, self.add
+        return (a(m(u[1], v[2]), self.scale(m(u[2], v[1]), -1)),
+                a(m(u[2], v[0]), self.scale(m(u[0], v[2]), -1)),
+                a(m(u[0], v[1]), self.scale(m(u[1], v[0]), -1)))
+
+    def power_series(self, coeffs: Sequence[mpq], s: _Series) -> _Series:
+        """``Σ_k coeffs[k] s^k`` (``s`` is ``O(a²)``: powers beyond ``pa/2`` vanish)."""
+        out = self.const(coeffs[0])
+        pw = self.const(1)
+        for c in coeffs[1:]:
+            pw = self.mul(pw, s)
+            out = self.add(out, self.scale(pw, c))
+        return out
+
+
+def _q(v) -> mpq:
+    f = Fraction(v)
+    return mpq(f.numerator, f.denominator)
+
+
+def _rotation_vector(b: _Bivariate, st: Structure, pairs, triples):
+    """φ of the update starting at t = 0, per component, from the closed-form increments.
+
+    ``θ_n = (−(1 − cos a) x, sin a (cos(s+1)x − cos sx), sin a (sin(s+1)x − sin sx))`` for
+    node ``s`` (Li & Zhang (2017) eq. 7, increments over ``[s h, (s+1) h]``, ``Ω = 1``).
+    """
+    sa, ca = b.trig_a(False), b.trig_a(True)
+    minus_g_x = b.xshift(b.add(ca, b.const(-1)), 1)
+    th = []
+    for s in st.nodes:
+        re = b.add(b.trig_x(s + 1, True), b.scale(b.trig_x(s, True), -1))
+        im = b.add(b.trig_x(s + 1, False), b.scale(b.trig_x(s, False), -1))
+        th.append((minus_g_x, b.mul(sa, re), b.mul(sa, im)))
+    phi = [b.zero(), b.zero(), b.zero()]
+    terms: list[tuple[tuple, mpq]] = [(t, _q(w)) for t, w in zip(th, st.weights, strict=True)]
+    crosses: dict[tuple[int, int], tuple] = {}
+    for (i, j), c in pairs:
+        if c:
+            crosses[i, j] = crosses.get((i, j)) or b.cross(th[i], th[j])
+            terms.append((crosses[i, j], _q(c)))
+    for (m, i, j), c in triples:
+        if c:
+            crosses[i, j] = crosses.get((i, j)) or b.cross(th[i], th[j])
+            terms.append((b.cross(th[m], crosses[i, j]), _q(c)))
+    for vec, c in terms:
+        if c:
+            for k in range(3):
+                phi[k] = b.add(phi[k], b.scale(vec[k], c))
+    return phi, sa, ca
+
+
+def _drift(b: _Bivariate, st: Structure, pairs, triples) -> _Series:
+    """Drift about the cone axis over Ω, ``Δ n_x / (Ω T)``, as a bivariate series."""
+    phi, sa, ca = _rotation_vector(b, st, pairs, triples)
+    s2 = b.add(*(b.mul(p, p) for p in phi))
+    kmax = b.pa // 2 + 1
+    ew = b.power_series([mpq((-1) ** k, 4**k * factorial(2 * k)) for k in range(kmax)], s2)
+    sv = b.power_series([mpq((-1) ** k, 2 * 4**k * factorial(2 * k + 1)) for k in range(kmax)],
+                        s2)
+    ev = [b.mul(sv, p) for p in phi]
+    u = mpq(st.update)
+    cr, sr = b.trig_x(u / 2, True), b.trig_x(u / 2, False)
+    neg = functools.partial(b.scale, c=-1)
+    aw = b.add(b.mul(ew, cr), neg(b.mul(ev[0], sr)))  # E ⊗ ρ, ρ = (cos ΩT/2, sin ΩT/2, 0, 0)
+    ax = b.add(b.mul(ew, sr), b.mul(ev[0], cr))
+    ay = b.add(b.mul(ev[1], cr), b.mul(ev[2], sr))
+    az = b.add(b.mul(ev[2], cr), neg(b.mul(ev[1], sr)))
+    y = b.sqrt(b.xshift(b.add(b.mul(ax, ax), b.mul(ay, ay), b.mul(az, az)), -2), u / 2)
+    vabs = b.xshift(y, 1)  # |vec(E ρ)| = sin(ψ/2)
+    num = b.add(b.mul(vabs, cr), neg(b.mul(aw, sr)))  # tan(ψ/2 − ΩT/2) = num/den
+    den = b.add(b.mul(aw, cr), b.mul(vabs, sr))
+    z = b.mul(num, b.inv(den))
+    z2 = b.mul(z, z)
+    at = b.add(z, b.scale(b.mul(z, z2), mpq(-1, 3)), b.scale(b.mul(b.mul(z, z2), z2), mpq(1, 5)))
+    # n_x of the axis turned by the initial tilt q_a (about y by a): cos a v_x + sin a v_z
+    nx = b.mul(b.add(b.mul(ca, b.xshift(ax, -1)), b.mul(sa, b.xshift(az, -1))), b.inv(y))
+    return b.xshift(b.scale(b.mul(at, nx), 2 / u), -1)
+
+
+def drift_series(structure: Structure, coefficients: Sequence, triple_coefficients: Sequence = (),
+                 *, x_order: int | None = None) -> dict[int, tuple[Fraction, ...]]:
+    """Exact double series of the classical-coning drift about the cone axis.
+
+    ``drift = Ω Σ_{p, q} d[p][q] a^p (Ωh)^q`` (rad/s, the sign of Li & Zhang (2017) Table 1
+    reversed: ``d = −c``), for the increment ``structure`` with pair ``coefficients`` and
+    ``triple_coefficients`` (one per ``structure.triples``), to ``a^{A_ORDER}`` and
+    ``x^{x_order}`` (default ``2N + 6``). Returns ``{p: (d[p][0], …, d[p][x_order])}`` for
+    even ``p``; odd powers of ``a`` vanish.
+    """
+    if structure.input != "increment":
+        raise ValueError("the finite-amplitude series is derived for increment input only; "
+                         f"{structure.name!r} takes rate samples")
+    if len(coefficients) != len(structure.pairs):
+        raise ValueError(f"{len(structure.pairs)} pair coefficients expected, "
+                         f"got {len(coefficients)}")
+    if len(triple_coefficients) != len(structure.triples):
+        raise ValueError(f"{len(structure.triples)} triple coefficients expected, "
+                         f"got {len(triple_coefficients)}")
+    x_order = 2 * structure.n + 6 if x_order is None else int(x_order)
+    b = _Bivariate(A_ORDER, x_order + 3)  # the divisions by x lose three orders
+    d = _drift(b, structure, list(zip(structure.pairs, coefficients, strict=True)),
+               list(zip(structure.triples, triple_coefficients, strict=True)))
+    return {p: tuple(Fraction(int(v.numerator), int(v.denominator)) for v in d[p][:x_order + 1])
+            for p in range(0, A_ORDER + 1, 2)}
+
+
+def leading_terms(series: dict[int, tuple[Fraction, ...]]
+                  ) -> tuple[tuple[int, int, Fraction], ...]:
+    """``(a power, x power, c)`` of each power of ``a``'s leading term, drift ``= −c a^p Ω x^q``
+    (powers whose series vanishes to the length examined are left out)."""
+    out = []
+    for p, row in sorted(series.items()):
+        q = next((k for k, v in enumerate(row) if v), None)
+        if q is not None:
+            out.append((p, q, -row[q]))
+    return tuple(out)
+
+
+def with_last_triples(structure: Structure) -> Structure:
+    """``structure`` with the triple terms ``θ_L × (θ_{L−m} × θ_L)``, m = 1 … L, ``θ_L`` its
+    last node (conventional: θ_N; single chain: θ_k)."""
+    last = len(structure.nodes) - 1
+    triples = tuple((last, last - m, last) for m in range(1, last + 1))
+    return replace(structure, name=f"{structure.name}, triple θ_L×(θ_(L−m)×θ_L)",
+                   triples=triples)
+
+
+def _to_sp(v: Fraction) -> sp.Rational:
+    return sp.Rational(v.numerator, v.denominator)
+
+
+@functools.lru_cache(maxsize=64)
+def derive_triple(structure: Structure) -> Design:
+    """Pair coefficients of the ``a²`` (coning) design plus triple coefficients cancelling the
+    ``a⁴`` drift order by order in ``Ωh`` through the order of the ``a²`` law.
+
+    ``structure`` must list its triple terms (e.g. :func:`with_last_triples`). The ``a⁴``
+    drift is affine in the triple coefficients (checked): one :func:`drift_series` per term
+    gives its column; conditions are taken lowest order first while the system stays
+    consistent, and free coefficients are settled by minimum norm (exact).
+    """
+    if not structure.triples:
+        raise ValueError(f"{structure.name!r} has no triple terms; add them with "
+                         "with_last_triples()")
+    plain = derive(replace(structure, triples=()))
+    top = plain.order if plain.order is not None else 2 * structure.n
+    zeros = (Fraction(0),) * len(structure.triples)
+    base = drift_series(structure, plain.coefficients, zeros)[4]
+    cols = []
+    for k in range(len(structure.triples)):
+        unit = tuple(Fraction(int(i == k)) for i in range(len(zeros)))
+        cols.append([v - w for v, w in zip(drift_series(structure, plain.coefficients, unit)[4],
+                                           base, strict=True)])
+    rows: list[list[sp.Rational]] = []
+    rhs: list[sp.Rational] = []
+    for q in range(top + 1):
+        trial_a = sp.Matrix([*rows, [_to_sp(c[q]) for c in cols]])
+        trial_b = sp.Matrix([*rhs, -_to_sp(base[q])])
+        if trial_a.rank() != trial_a.row_join(trial_b).rank():
+            break
+        rows.append([_to_sp(c[q]) for c in cols])
+        rhs.append(-_to_sp(base[q]))
+    a, bvec = sp.Matrix(rows), sp.Matrix(rhs)
+    _, piv = a.T.rref()
+    a, bvec = a.extract(list(piv), list(range(a.cols))), bvec.extract(list(piv), [0])
+    sol = a.T * (a * a.T).LUsolve(bvec) if a.rows else sp.zeros(len(cols), 1)
+    tri = tuple(Fraction(int(sp.fraction(v)[0]), int(sp.fraction(v)[1])) for v in sol)
+    series = drift_series(structure, plain.coefficients, tri)
+    c2 = plain.drift_constant or Fraction(0)
+    if any(series[2][q] != -c2 * (q == plain.order)
+           for q in range(min(len(series[2]), (plain.order or 0) + 1))):
+        raise ArithmeticError("the triple terms changed the a² drift; the design is wrong")
+    return replace(plain, structure=structure, triple_coefficients=tri,
+                   amplitude_law=leading_terms(series), conditions=plain.conditions + len(rows))

@@ -1,0 +1,89 @@
+"""Finite-amplitude design: the exact double series in (a, Ωh) and the triple-term sets."""
+
+from __future__ import annotations
+
+import json
+from fractions import Fraction as F
+
+import pytest
+
+from strapdown.algorithms.coning import TABLE3
+from strapdown.cli import main
+from strapdown.design import designer as D
+from strapdown.design import finite_amplitude as FA
+
+
+@pytest.mark.parametrize("st", [D.interval_structure(3), D.interval_structure(4, "all-pairs"),
+                                D.single_chain_structure(5), D.uncompressed_structure(2, 2)],
+                         ids=lambda s: s.name)
+def test_a2_row_is_the_designers_independent_series(st):
+    # the designer's a² series (a separate derivation, Li & Zhang's lag-sum form) per update,
+    # over Ω T: row[q] = resid[q + 1] / U (the designer reports c = −resid / U)
+    d = D.derive(st)
+    e0, pair = D._coning_series(st, 16)
+    resid = [e0[p] + sum(pair[k][p] * c for k, c in enumerate(d.coefficients))
+             for p in range(17)]
+    row = FA.drift_series(st, d.coefficients, x_order=14)[2]
+    assert list(row) == [resid[q + 1] / st.update for q in range(15)]
+
+
+def test_the_a4_problem_and_its_cure():
+    st = D.interval_structure(5)
+    plain = FA.drift_series(st, TABLE3[5])
+    assert FA.leading_terms(plain)[:2] == ((2, 10, F(1, 5544)), (4, 4, F(115, 672)))
+    d = FA.derive_triple(FA.with_last_triples(st))
+    ser = FA.drift_series(d.structure, d.coefficients, d.triple_coefficients)
+    assert ser[2] == plain[2]  # triple terms leave a² alone
+    assert all(v == 0 for v in ser[4][:11]) and ser[4][12] != 0
+    assert all(v == 0 for v in ser[6][:5]) and ser[6][6] != 0  # a⁶x⁴ went with a⁴x⁴
+    assert d.amplitude_law[1][:2] == (4, 12)
+
+
+@pytest.mark.parametrize("n", [2, 3, 4, 5, 6])
+@pytest.mark.parametrize("make", [D.interval_structure, D.single_chain_structure])
+def test_triple_design_cancels_a4_through_the_a2_order(make, n):
+    d = FA.derive_triple(FA.with_last_triples(make(n)))
+    law = dict(((p, (q, c)) for p, q, c in d.amplitude_law))
+    assert law[2] == (2 * n, D.derive(make(n)).drift_constant)
+    assert law[4][0] == 2 * n + 2 and len(d.triple_coefficients) == n - 1
+
+
+def test_a4_is_affine_in_the_triple_coefficients():
+    st = FA.with_last_triples(D.single_chain_structure(3))
+    pc = D.derive(D.single_chain_structure(3)).coefficients
+    s0, s1, s2 = (FA.drift_series(st, pc, (F(k), F(-k, 3))) for k in (0, 1, 2))
+    assert [b - a for a, b in zip(s0[4], s1[4], strict=True)] == [
+        (c - a) / 2 for a, c in zip(s0[4], s2[4], strict=True)]
+    assert s1[6] != s0[6]
+
+
+def test_bad_input():
+    with pytest.raises(ValueError, match="no triple terms"):
+        FA.derive_triple(D.interval_structure(3))
+    with pytest.raises(ValueError, match="increment input"):
+        FA.drift_series(D.rate_structure(2), (0, 0, 0))
+    with pytest.raises(ValueError, match="triple coefficients expected"):
+        FA.drift_series(FA.with_last_triples(D.interval_structure(3)), TABLE3[3], (1,))
+    with pytest.raises(ValueError, match="increment input only"):
+        D.Structure("r", "rate", 1, (F(0), F(1)), (F(1, 2), F(1, 2)), ((0, 1),), (((0, F(1)),),),
+                    1, ((0, 0, 1),))
+
+
+def test_cli_triple_json_and_errors(capsys):
+    assert main(["coefficients", "--form", "single-chain", "--subsamples", "3", "--triple",
+                 "--json"]) == 0
+    rec = json.loads(capsys.readouterr().out)
+    assert rec["triple_coefficients"] == ["19/1080", "-1/270"]
+    assert rec["triple_terms"] == ["θ[k]×(θ[k−1]×θ[k])", "θ[k]×(θ[k−2]×θ[k])"]
+    assert rec["amplitude_law"][:2] == [{"a_power": 2, "order": 6, "constant": "1/280"},
+                                        {"a_power": 4, "order": 8, "constant": "17/129600"}]
+    assert main(["coefficients", "--form", "cross-with-last", "--subsamples", "4",
+                 "--triple"]) == 0
+    assert "2834959/483840" in capsys.readouterr().out
+    for bad in (["--form", "rate", "--subsamples", "3", "--triple"],
+                ["--form", "lag", "--subsamples", "3", "--triple", "--target", "polynomial"]):
+        with pytest.raises(SystemExit) as exc:
+            main(["coefficients", *bad])
+        assert exc.value.code == 2
+        err = capsys.readouterr().err
+        assert "--triple" in err and len(err.strip().splitlines()) == 1
