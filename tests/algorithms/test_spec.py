@@ -69,8 +69,11 @@ def test_grammar_examples():
     ("miller", "needs --step"),
     ("panov:step=0.01:beta=0.2", "one coefficient"),
     ("miller:step=0.01:coefficients=table3", "alpha/--beta, not --coefficients"),
-    ("rotvec:alpha=0.5", "belong to miller, panov and power"),
-    ("rate-single:step=0.01", "takes no --step"),
+    ("rotvec:alpha=0.5", "rotvec takes no alpha"),
+    ("rate-three:N=3", r"rate-three takes no N \(subsamples\)"),
+    ("rk4:exact_exp=true", "rk4 takes no exact_exp"),
+    ("miller:step=0.01:rk4_step=2td", "miller takes no rk4_step"),
+    ("rate-single:step=0.01", "rate-single takes no step"),
     ("miller:step=-1", "positive"),
 ])
 def test_invalid_specs_name_the_problem(text, msg):

@@ -265,6 +265,9 @@ def parse_spec(spec: str) -> dict[str, Any]:
         if not eq or key not in SPEC_KEYS:
             raise ValueError(f"spec {spec!r}: {o!r} is not key=value with a key among "
                              f"N, {', '.join(SPEC_KEYS)}")
+        if key not in ("structure", "coefficients") and key not in REGISTRY[name].options:
+            shown = "N (subsamples)" if key == "subsamples" else key
+            raise ValueError(f"spec {spec!r}: {name} takes no {shown}")
         out[key] = _value(spec, key, value.strip())
     return out
 
