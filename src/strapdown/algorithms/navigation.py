@@ -123,7 +123,8 @@ class NavStream:
 
     def __init__(self, n: int, *, h: float, lat: float, lon: float, height: float,
                  v0: ArrayLike | None = None, q0: ArrayLike | None = None,
-                 structure: str = "conventional", t0: float = 0.0, sculling: bool = True):
+                 structure: NavStructure = "conventional", t0: float = 0.0,
+                 sculling: bool = True):
         from strapdown._core.validation import positive
         from strapdown.algorithms.velocity import _n, _structure
 

@@ -44,6 +44,7 @@ from tqdm import tqdm
 from strapdown._core.kinds import InputKind
 from strapdown.algorithms.navigation import NavStream
 from strapdown.algorithms.rate import JITTER_TOLERANCE
+from strapdown.algorithms.velocity import NavStructure
 from strapdown.io import read_imu
 from strapdown.io.files import atomic_path
 from strapdown.io.readers import (
@@ -300,7 +301,8 @@ def navigate_log(imu: str | os.PathLike[str], out: str | os.PathLike[str], *, la
                  attitude_deg: ArrayLike | None = None, kind: InputKind = "rate",
                  units: GyroUnit | None = None, acc_units: AccUnit | None = None,
                  columns: Sequence[str] | None = None, sample_rate_hz: float | None = None,
-                 subsamples: int = 2, structure: str = "conventional", sculling: bool = True,
+                 subsamples: int = 2, structure: NavStructure = "conventional",
+                 sculling: bool = True,
                  accept_unit_warning: bool = False, progress: bool = False) -> dict[str, Any]:
     """Navigate a log and write one row per update (see the module docstring).
 

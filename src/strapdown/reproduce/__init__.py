@@ -18,7 +18,8 @@ from typing import Literal, get_args
 __all__ = ["REPRODUCTIONS", "Reproduction", "ReproductionName", "reproduction"]
 
 #: The reproductions' command-line names, in the order the command line lists them.
-ReproductionName = Literal["li2017", "wang-rate", "wang-sliding", "plaksiy2024", "zhang2021"]
+ReproductionName = Literal["li2017", "wang-rate", "wang-sliding", "plaksiy2024", "zhang2021",
+                           "sculling"]
 
 
 @dataclass(frozen=True)
@@ -40,6 +41,9 @@ REPRODUCTIONS: dict[ReproductionName, Reproduction] = {
     "plaksiy2024": Reproduction("strapdown.reproduce.plaksiy2024",
                                 "Plaksiy's Krylov-model study of algorithms A1-A3"),
     "zhang2021": Reproduction("strapdown.reproduce.zhang2021", "Zhang & Yu's cone angles"),
+    "sculling": Reproduction("strapdown.reproduce.sculling",
+                             "sculling law and duality (Savage, Ignagni), WGS-84 navigation, "
+                             "smsfusion"),
 }
 
 
