@@ -46,7 +46,7 @@ def _helpers() -> str:
     """The small functions of :mod:`strapdown.algorithms._nav_kernels`, in C."""
     consts = "\n".join(f"#define {k} {_lit(v)}" for k, v in _CONSTANTS.items())
     return f"""
-/* WGS-84 (NIMA TR8350.2): semi-major axis, flattening, e^2, Earth rate, Somigliana */
+/* WGS-84 (NIMA TR8350.2 (2000)): semi-major axis, flattening, e^2, Earth rate, Somigliana */
 {consts}
 
 static void sd_cross(const real_t a[3], const real_t b[3], real_t out[3])

@@ -1,7 +1,7 @@
 """The WGS-84 Earth: radii of curvature, normal gravity, Earth and transport rates (NED).
 
-Constants of the WGS-84 ellipsoid; normal gravity by Somigliana's closed formula with the
-second-order free-air height correction
+Constants of the WGS-84 ellipsoid (NIMA TR8350.2 (2000)); normal gravity by Somigliana's
+closed formula with the second-order free-air height correction
 ``γ(L, h) = γ0(L) [1 − 2/a (1 + f + m − 2 f sin²L) h + 3 h²/a²]``; the navigation frame is
 local north–east–down (Savage (1998b)). The compiled navigation kernel
 (:mod:`strapdown.algorithms._nav_kernels`) repeats these formulas; the tests hold them
