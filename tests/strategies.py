@@ -29,6 +29,7 @@ from strapdown.rotation import dcm_from_quat
 
 __all__ = [
     "CONING_CHOICES",
+    "PAIR_CONING_CHOICES",
     "angles",
     "batch_shapes",
     "chunk_sizes",
@@ -211,7 +212,13 @@ def split(x: np.ndarray, sizes: list[int]) -> list[np.ndarray]:
     return out
 
 
+#: The (name, N) of :data:`CONING_CHOICES` whose sets have pair terms only (the
+#: finite-amplitude sets add triple cross products and run conventional or single-chain).
+PAIR_CONING_CHOICES: tuple[tuple[str, int], ...] = tuple(
+    c for c in CONING_CHOICES if not coefficient_set(*c).triples)
+
+
 def coning_sets() -> st.SearchStrategy[CoefficientSet]:
-    """A named coning set: any name of ``coefficient_set_names()`` × every N it accepts
-    (:data:`CONING_CHOICES`). Shrinks towards the first name with N = 1."""
-    return st.sampled_from(CONING_CHOICES).map(lambda c: coefficient_set(*c))
+    """A named pair-only coning set: any name of ``coefficient_set_names()`` × every N it
+    accepts (:data:`PAIR_CONING_CHOICES`). Shrinks towards the first name with N = 1."""
+    return st.sampled_from(PAIR_CONING_CHOICES).map(lambda c: coefficient_set(*c))

@@ -25,8 +25,9 @@ def _every_spec():
     for name, fam in REGISTRY.items():
         for structure in fam.structures:
             for coeffs in (None, *fam.coefficient_names()):
-                if coeffs == "miller" or (structure == "single-chain"
-                                          and coeffs not in (None, "table3", "none")):
+                if coeffs == "miller" or (structure == "single-chain" and coeffs not in (
+                        None, "table3", "none", "finite-amplitude")) or (
+                        structure == "realtime" and coeffs == "finite-amplitude"):
                     continue
                 extra = {"step": 0.01} if fam.stepped else {}
                 yield AlgorithmSpec(name, structure=structure, coefficients=coeffs, **extra)

@@ -57,7 +57,8 @@ def _equivariance_bound(theta, cs):
     g = np.linalg.norm(theta, axis=-1).reshape(-1, cs.n)
     lin = g.sum(axis=1)
     quad = np.einsum("ij,gi,gj->g", np.abs(cs.matrix), g, g)
-    return 16 * _EPS * (lin + quad)
+    cubic = sum(abs(float(c)) * g[:, m] * g[:, i] * g[:, j] for m, i, j, c in cs.triples)
+    return 16 * _EPS * (lin + quad + cubic)
 
 
 @pytest.mark.parametrize(("name", "n"), CONING_CHOICES, ids=[f"{a}-{b}" for a, b in CONING_CHOICES])

@@ -521,3 +521,59 @@ def window4_kernel(x, weights, pc, sa, sb, b0, step, stride, q_out):
         py += c23 * e23y
         pz += c23 * e23z
         _update_rows(q_out, r, px, py, pz, r + stride)
+
+
+@njit(cache=True, inline="always")
+def _add_triples(theta, base, tm, ti, tj, tc, phi):
+    """φ += Σ_p tc[p] θ_m × (θ_i × θ_j) over theta[base + …] (finite-amplitude sets)."""
+    for p in range(tc.shape[0]):
+        c = tc[p]
+        m = base + tm[p]
+        i = base + ti[p]
+        j = base + tj[p]
+        ux = theta[i, 1] * theta[j, 2] - theta[i, 2] * theta[j, 1]
+        uy = theta[i, 2] * theta[j, 0] - theta[i, 0] * theta[j, 2]
+        uz = theta[i, 0] * theta[j, 1] - theta[i, 1] * theta[j, 0]
+        ax, ay, az = theta[m, 0], theta[m, 1], theta[m, 2]
+        phi[0] += c * (ay * uz - az * uy)
+        phi[1] += c * (az * ux - ax * uz)
+        phi[2] += c * (ax * uy - ay * ux)
+
+
+@njit(cache=True)
+def conventional_triple_kernel(theta, k, tm, ti, tj, tc, q0, q_out):
+    """Conventional structure with triple cross products: :func:`conventional_kernel`'s φ
+    (the same operations) plus ``Σ_p tc[p] θ_m × (θ_i × θ_j)`` over each update's N
+    increments (tm, ti, tj int64 node indices, tc float64)."""
+    n = k.shape[0]
+    phi = np.empty(3)
+    q_out[0, :] = q0
+    for u in range(theta.shape[0] // n):
+        _rotvec(theta, u * n, n, k, phi)
+        _add_triples(theta, u * n, tm, ti, tj, tc, phi)
+        _update(q_out[u], phi, q_out[u + 1])
+
+
+@njit(cache=True)
+def single_chain_triple_kernel(theta, c, tm, ti, tj, tc, start, q_out):
+    """Single chain in steady state with triple terms: ``φ_i = θ_i + Σ_{p=1}^{N−1} c[p−1]
+    θ_{i−p} × θ_i + Σ_p tc[p] θ_m × (θ_i' × θ_j')`` over the window θ_{i−N+1} … θ_i (node
+    indices 0 … N−1), ``q ← q ⊗ q(φ)``. ``theta[:start]`` is history (start ≥ N − 1);
+    ``q_out[0]`` holds the attitude before ``theta[start]``; one row per new increment."""
+    nm1 = c.shape[0]
+    phi = np.empty(3)
+    for i in range(start, theta.shape[0]):
+        bx, by, bz = theta[i, 0], theta[i, 1], theta[i, 2]
+        phi[0] = bx
+        phi[1] = by
+        phi[2] = bz
+        for p in range(1, nm1 + 1):
+            cp = c[p - 1]
+            if cp != 0.0:
+                ax, ay, az = theta[i - p, 0], theta[i - p, 1], theta[i - p, 2]
+                phi[0] += cp * (ay * bz - az * by)
+                phi[1] += cp * (az * bx - ax * bz)
+                phi[2] += cp * (ax * by - ay * bx)
+        _add_triples(theta, i - nm1, tm, ti, tj, tc, phi)
+        k = i - start
+        _update(q_out[k], phi, q_out[k + 1])

@@ -181,3 +181,47 @@ def windowed(x, offsets, weights, pairs, coefficients, sa, sb, starts, q0, strid
     sp = [(i, j, sb * c) for (i, j), c in zip(pairs, coefficients, strict=True)]
     phis = [windowed_rotvec([tuple(x[b + o]) for o in offsets], sw, sp, m.zero) for b in starts]
     return chain(phis, q0, stride, m)
+
+
+def _cross(u, v):
+    return (u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0])
+
+
+def add_triples(theta, base, triples, phi):
+    """φ + Σ (m, i, j, c) c θ_m × (θ_i × θ_j) over theta[base + …] (finite-amplitude sets)."""
+    px, py, pz = phi
+    for m, i, j, c in triples:
+        ux, uy, uz = _cross(theta[base + i], theta[base + j])
+        ax, ay, az = theta[base + m]
+        px += c * (ay * uz - az * uy)
+        py += c * (az * ux - ax * uz)
+        pz += c * (ax * uy - ay * ux)
+    return px, py, pz
+
+
+def conventional_triple(theta, k, triples, q0, m: Backend):
+    """Reference twin of :func:`strapdown.algorithms._kernels.conventional_triple_kernel`."""
+    n = len(k)
+    out = [tuple(q0)]
+    for u in range(len(theta) // n):
+        phi = add_triples(theta, u * n, triples, rotvec(theta, u * n, n, k, m.zero))
+        out.append(update(out[-1], phi, m))
+    return out
+
+
+def single_chain_triple(theta, c, triples, start, q0, m: Backend):
+    """Reference twin of :func:`strapdown.algorithms._kernels.single_chain_triple_kernel`
+    (``q0`` the attitude before ``theta[start]``)."""
+    nm1 = len(c)
+    out = [tuple(q0)]
+    for i in range(start, len(theta)):
+        bx, by, bz = theta[i]
+        px, py, pz = bx, by, bz
+        for p in range(1, nm1 + 1):
+            if c[p - 1] != 0:
+                ax, ay, az = theta[i - p]
+                px += c[p - 1] * (ay * bz - az * by)
+                py += c[p - 1] * (az * bx - ax * bz)
+                pz += c[p - 1] * (ax * by - ay * bx)
+        out.append(update(out[-1], add_triples(theta, i - nm1, triples, (px, py, pz)), m))
+    return out

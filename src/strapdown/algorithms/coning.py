@@ -24,6 +24,11 @@ with an upper-triangular coefficient matrix ``K`` (``K[i, j]`` multiplies
     Miller (1983) three-sample set: ``33/80 θ1×θ3 + 57/80 θ2×(θ3 − θ1)``.
 ``none``
     No correction (``φ = Σθ``).
+``finite-amplitude``
+    Table 3 plus triple cross products ``Σ_m τ_m θ_N × (θ_{N−m} × θ_N)`` that cancel the
+    ``a⁴`` classical-coning drift through the order of the Table 1 law
+    (:mod:`.finite_amplitude`; the single chain has its own set there). Runs in the
+    conventional and single-chain structures.
 
 A user set is any ``(N, N)`` strictly upper-triangular matrix
 (:func:`user_coefficients`).
@@ -42,6 +47,7 @@ from numpy.typing import ArrayLike, NDArray
 from strapdown._core.kinds import InputKind
 from strapdown._core.validation import as_vectors, finite_array, positive_int
 from strapdown.algorithms.errata import eq6_printed_matrix
+from strapdown.algorithms.finite_amplitude import triple_terms
 
 __all__ = [
     "CONING_SETS",
@@ -55,6 +61,7 @@ __all__ = [
     "coning_set_name",
     "rotation_vectors",
     "table1_drift_constant",
+    "triple_arrays",
     "user_coefficients",
 ]
 
@@ -65,7 +72,7 @@ MAX_SUBSAMPLES = 6
 F = Fraction
 
 #: The named coefficient sets (see the module docstring).
-ConingSetName = Literal["table3", "lag", "eq6-printed", "miller", "none"]
+ConingSetName = Literal["table3", "lag", "eq6-printed", "miller", "none", "finite-amplitude"]
 #: Their names, in the order the command line lists them.
 CONING_SETS: tuple[ConingSetName, ...] = get_args(ConingSetName)
 
@@ -114,6 +121,9 @@ class CoefficientSet:
     classical_optimum : bool
         Whether the set has the optimal classical-coning lag sums, so that the
         Table 1 drift law applies.
+    triples : tuple of (int, int, int, Fraction)
+        Triple cross products ``(m, i, j, τ)``: ``τ θ_m × (θ_i × θ_j)`` added to φ (0-based;
+        empty for the pair-only sets).
     """
 
     name: str
@@ -122,6 +132,7 @@ class CoefficientSet:
     exact: tuple[tuple[Fraction, ...], ...] | None = field(default=None, repr=False)
     reference: str = ""
     classical_optimum: bool = False
+    triples: tuple[tuple[int, int, int, Fraction], ...] = field(default=(), repr=False)
 
     def lag_sums(self) -> NDArray[np.float64]:
         """``K_m = Σ_{j−i=m} k_ij`` for ``m = 1 … N−1``."""
@@ -172,12 +183,29 @@ def _none(n):
     return _from_exact("none", _zeros(n), "no coning correction", n == 1)
 
 
+def _finite_amplitude(n):
+    base = _table3(n)
+    return CoefficientSet("finite-amplitude", n, base.matrix, base.exact,
+                          "Table 3 + triple cross products (strapdown designer, a⁴ cancelled)",
+                          True, triple_terms("conventional", n))
+
+
+def triple_arrays(triples: tuple[tuple[int, int, int, Fraction], ...]
+                  ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64],
+                             NDArray[np.float64]]:
+    """Triple terms ``(m, i, j, τ)`` as the kernels read them: m, i, j (int64) and τ arrays."""
+    cols = [np.array([t[k] for t in triples], dtype=np.int64) for k in range(3)]
+    return cols[0], cols[1], cols[2], np.array([float(t[3]) for t in triples],
+                                               dtype=np.float64)
+
+
 _REGISTRY: dict[ConingSetName, Callable[[int], CoefficientSet]] = {
     "table3": _table3,
     "lag": _lag,
     "eq6-printed": _eq6,
     "miller": _miller,
     "none": _none,
+    "finite-amplitude": _finite_amplitude,
 }
 if tuple(_REGISTRY) != CONING_SETS:  # one list of names: the Literal
     raise RuntimeError(f"coefficient sets {tuple(_REGISTRY)} and ConingSetName {CONING_SETS} "
@@ -242,7 +270,7 @@ def rotation_vectors(increments: ArrayLike, coefficients: CoefficientSet
     -------
     ndarray of shape (M, 3)
         ``φ = Σθ + Σ_{i<j} k_ij θ_i × θ_j`` for each group (Li & Zhang 2017
-        eq. 6 in general pair form).
+        eq. 6 in general pair form), plus the set's triple terms ``τ θ_m × (θ_i × θ_j)``.
     """
     theta = as_vectors(increments, "increments")
     if theta.ndim != 2:
@@ -260,6 +288,8 @@ def rotation_vectors(increments: ArrayLike, coefficients: CoefficientSet
         for j in range(i + 1, n):
             if k[i, j] != 0.0:
                 phi = phi + k[i, j] * np.cross(g[:, i], g[:, j])
+    for m, i, j, c in coefficients.triples:
+        phi = phi + float(c) * np.cross(g[:, m], np.cross(g[:, i], g[:, j]))
     return phi
 
 

@@ -66,12 +66,16 @@ class MpSolution:
 
 def _single_chain_phis(theta, coefficients: CoefficientSet):
     """Single-chain rotation vectors in mpmath, with the same start-up as the float64 path."""
+    from strapdown.algorithms.finite_amplitude import triple_terms
     from strapdown.algorithms.structures import single_chain_coefficients
 
-    if coefficients.name not in ("table3", "none"):
-        raise ValueError("the single chain takes 'table3' (designed optimum) or 'none'")
-    n = coefficients.n if coefficients.name == "table3" else 1
+    if coefficients.name not in ("table3", "none", "finite-amplitude"):
+        raise ValueError("the single chain takes 'table3' (designed optimum), "
+                         "'finite-amplitude' or 'none'")
+    n = coefficients.n if coefficients.name != "none" else 1
     sets = {m: [_mpf(c) for c in single_chain_coefficients(m)] for m in range(1, n + 1)}
+    triples = ([(m, i, j, _mpf(c)) for m, i, j, c in triple_terms("single-chain", n)]
+               if coefficients.name == "finite-amplitude" else [])
     zero = mpmath.mpf(0)
     phis = []
     for k in range(len(theta)):
@@ -80,7 +84,10 @@ def _single_chain_phis(theta, coefficients: CoefficientSet):
         last = len(window) - 1
         pairs = [(last - m, last, c) for m, c in enumerate(cs, start=1)]
         w = [zero] * last + [mpmath.mpf(1)]
-        phis.append(_reference.windowed_rotvec(window, w, pairs, zero))
+        phi = _reference.windowed_rotvec(window, w, pairs, zero)
+        if k >= n - 1:  # steady state: the finite-amplitude triple terms
+            phi = _reference.add_triples(window, 0, triples, phi)
+        phis.append(phi)
     return phis
 
 
@@ -234,11 +241,19 @@ def run_mp(
         edges = [tm0 + k * hm for k in range(samples + 1)]
         theta = [motion.increment_mp(edges[k], edges[k + 1]) for k in range(samples)]
         q0 = motion.attitude_mp(tm0)
-        if structure == "conventional":
+        if structure == "conventional" and coefficients.triples:
+            triples = [(m, i, j, _mpf(c)) for m, i, j, c in coefficients.triples]
+            q = _reference.conventional_triple(theta, _mp_matrix(coefficients), triples, q0,
+                                               MPMATH)
+            t_out = edges[::n]
+            chain = np.zeros(len(q), int)
+        elif structure == "conventional":
             q = _reference.conventional(theta, _mp_matrix(coefficients), q0, MPMATH)
             t_out = edges[::n]
             chain = np.zeros(len(q), int)
         elif structure == "realtime":
+            if coefficients.triples:
+                raise ValueError("the real-time structure runs pair-only sets")
             ks = [_mp_matrix(s) for s in startup_sets(coefficients)]
             q = _reference.realtime(theta, ks, q0, MPMATH)
             t_out = edges
@@ -247,7 +262,7 @@ def run_mp(
             q = _reference.chain(_single_chain_phis(theta, coefficients), [q0], 1, MPMATH)
             t_out = edges
             chain = np.zeros(len(q), int)
-            n_sc = n if coefficients.name == "table3" else 1
+            n_sc = n if coefficients.name != "none" else 1
             return _errors(motion, q, t_out, chain, digits, min(n_sc - 1, len(q) - 1))
         return _errors(motion, q, t_out, chain, digits)
 

@@ -60,6 +60,9 @@ class Rotvec(Family):
     def check(self, spec: AlgorithmSpec) -> None:
         super().check(spec)
         self.coefficient_set(spec)  # unknown sets and impossible N fail here
+        if spec.resolved_coefficients == "finite-amplitude" and spec.structure == "realtime":
+            raise ValueError("coefficients finite-amplitude run in the conventional and "
+                             "single-chain structures, not realtime")
 
     def coefficient_set(self, spec: AlgorithmSpec) -> CoefficientSet:
         """The configured coefficient set (what the C exporter and the filter need)."""
@@ -95,6 +98,9 @@ class Rotvec(Family):
 
         if spec.structure != "conventional":
             raise ValueError("the filter runs rotvec in the conventional structure")
+        if self.coefficient_set(spec).triples:
+            raise ValueError("the filter runs pair-only coefficient sets, not "
+                             f"{spec.resolved_coefficients!r} (triple cross products)")
         n = spec.subsamples
         cs = self.coefficient_set(spec)
         ii, jj = np.nonzero(cs.matrix)

@@ -63,6 +63,9 @@ class RotvecStream:
                              "or single-chain")
         if not isinstance(coefficients, CoefficientSet):
             raise ValueError("coefficients must be a CoefficientSet")
+        if coefficients.triples:
+            raise ValueError(f"the streaming runner takes pair-only sets; {coefficients.name!r} "
+                             "has triple cross products (run it on the whole record)")
         self.structure = structure
         self.coefficients = coefficients
         self.h = positive(h, "h (sample interval)")

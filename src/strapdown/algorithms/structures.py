@@ -42,8 +42,10 @@ from strapdown.algorithms.coning import (
     WindowedAlgorithm,
     coefficient_set,
     coning_set_name,
+    triple_arrays,
 )
 from strapdown.algorithms.family import IncrementStructure
+from strapdown.algorithms.finite_amplitude import triple_terms
 
 __all__ = [
     "STRUCTURES",
@@ -172,7 +174,11 @@ def conventional(
         theta = theta[: theta.shape[0] - rest]
     m = theta.shape[0] // n
     q = np.empty((m + 1, 4))
-    _kernels.conventional_kernel(theta, np.ascontiguousarray(coefficients.matrix), q0, q)
+    if coefficients.triples:
+        _kernels.conventional_triple_kernel(theta, np.ascontiguousarray(coefficients.matrix),
+                                            *triple_arrays(coefficients.triples), q0, q)
+    else:
+        _kernels.conventional_kernel(theta, np.ascontiguousarray(coefficients.matrix), q0, q)
     t = t0 + np.arange(m + 1) * (n * h)
     return AttitudeSolution(t, q, "conventional", coefficients, h, n * h, np.zeros(m + 1, int))
 
@@ -226,6 +232,9 @@ def realtime(
     """
     theta, h, q0, t0 = _check_inputs(increments, coefficients, h, q0, t0)
     n = coefficients.n
+    if coefficients.triples:
+        raise ValueError(f"the real-time structure runs pair-only sets; {coefficients.name!r} "
+                         "has triple terms (run it conventional or single-chain)")
     sets = startup_sets(coefficients) if startup is None else [*startup, coefficients]
     ks = stack_sets(sets)
     q = np.empty((theta.shape[0] + 1, 4))
@@ -254,13 +263,15 @@ def run_structure(name: IncrementStructure, increments: ArrayLike,
     if name == "realtime":
         return realtime(increments, coefficients, h=h, t0=t0, q0=q0)
     if name == "single-chain":
-        if coefficients.name not in ("table3", "none"):
+        if coefficients.name not in ("table3", "none", "finite-amplitude"):
             raise ValueError(
                 "the single chain takes its coefficients from the designer: use "
-                f"'table3' (the classical-coning optimum) or 'none', not {coefficients.name!r}"
+                "'table3' (the classical-coning optimum), 'finite-amplitude' or 'none', not "
+                f"{coefficients.name!r}"
             )
-        n = coefficients.n if coefficients.name == "table3" else 1
-        return single_chain(increments, n, h=h, t0=t0, q0=q0)
+        n = coefficients.n if coefficients.name != "none" else 1
+        return single_chain(increments, n, h=h, t0=t0, q0=q0,
+                            triple=coefficients.name == "finite-amplitude")
     raise ValueError(f"unknown structure {name!r}; choose one of {', '.join(STRUCTURES)}")
 
 
@@ -367,7 +378,7 @@ def single_chain_table(n: int) -> NDArray[np.float64]:
 
 
 def single_chain(increments: ArrayLike, n: int, *, h: float, t0: float = 0.0,
-                 q0: ArrayLike | None = None) -> AttitudeSolution:
+                 q0: ArrayLike | None = None, triple: bool = False) -> AttitudeSolution:
     """Single-chain high-rate structure: an attitude every h with N-subsample accuracy.
 
     ``φ_k = θ_k + Σ_{m=1}^{N−1} c_m θ_{k−m} × θ_k``, ``q_k = q_{k−1} ⊗ q(φ_k)``,
@@ -376,6 +387,10 @@ def single_chain(increments: ArrayLike, n: int, *, h: float, t0: float = 0.0,
     classical-coning drift equals the conventional N-subsample drift at the
     same h, from one chain (no sawtooth). Start-up: increment k < N−1 uses the
     (k+1)-sample set.
+
+    ``triple=True``: the finite-amplitude set, the same pairs plus
+    ``Σ_m τ_m θ_k × (θ_{k−m} × θ_k)`` once N − 1 previous increments exist
+    (:mod:`strapdown.algorithms.finite_amplitude`; the start-up is the plain one).
     """
     n = positive_int(n, "N (subsamples)")
     theta = np.ascontiguousarray(as_vectors(increments, "increments"))
@@ -386,7 +401,16 @@ def single_chain(increments: ArrayLike, n: int, *, h: float, t0: float = 0.0,
     q0 = _unit_q0(q0)
     q = np.empty((theta.shape[0] + 1, 4))
     q[0] = q0
-    _kernels.single_chain_kernel(theta, single_chain_table(n), 0, 0, q)
+    if not triple:
+        _kernels.single_chain_kernel(theta, single_chain_table(n), 0, 0, q)
+    else:
+        s = min(n - 1, theta.shape[0])
+        _kernels.single_chain_kernel(np.ascontiguousarray(theta[:s]), single_chain_table(n), 0,
+                                     0, q[:s + 1])
+        if theta.shape[0] > s:
+            tm, ti, tj, tc = triple_arrays(triple_terms("single-chain", n))
+            c = np.array([float(v) for v in single_chain_coefficients(n)], dtype=np.float64)
+            _kernels.single_chain_triple_kernel(theta, c, tm, ti, tj, tc, s, q[s:])
     t = t0 + np.arange(q.shape[0]) * h
     return AttitudeSolution(t, q, "single-chain", None, h, h, np.zeros(t.size, int),
                             min(n - 1, t.size - 1))

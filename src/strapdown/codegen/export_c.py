@@ -246,6 +246,9 @@ def _gen_rotvec(spec, real, h):
             raise ValueError("the single chain exports its designed coefficients only")
         return _gen_single_chain(spec.subsamples, real)
     cs = coefficient_set(spec.coefficients or "table3", spec.subsamples)
+    if cs.triples:
+        raise ValueError(f"export-c generates pair terms only; {cs.name!r} has triple cross "
+                         "products")
     if spec.structure == "conventional":
         return _gen_conventional(cs, real)
     return _gen_realtime(cs, real)
