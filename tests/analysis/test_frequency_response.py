@@ -81,3 +81,36 @@ def test_window_forms_and_errors():
         classical_coning_drift(AlgorithmSpec.parse("rotvec:N=2"), 0.01, math.pi)
     with pytest.raises(ValueError, match="AlgorithmSpec"):
         update_window("rotvec:N=3")
+
+
+@pytest.mark.parametrize(("text", "ratio"), [("rotvec:N=3", 3), ("rk4", 2),
+                                             ("rotvec:N=4:coefficients=finite-amplitude", 10),
+                                             ("rotvec:N=2:structure=single-chain", 5)])
+def test_spin_coning_response_is_the_simulated_drift(text, ratio):
+    from strapdown.truth.motions import SpinConing
+
+    spec = AlgorithmSpec.parse(text)
+    a, spp = math.radians(2.0), 120
+    motion = SpinConing(a, OMEGA, OMEGA * ratio)
+    s = spec.run_mp(motion, h=1.0 / spp, samples=2 * spp + spec.min_samples, digits=40)
+    k = s.startup
+    chains = chain_drift_rate(s.t[k:], s.err[k:, 0], s.chain[k:], period=1.0)
+    assert all(c.method == "whole-periods" for c in chains)
+    exact = classical_coning_drift(spec, a, 2 * math.pi / spp, cone_rate=OMEGA,
+                                   spin_ratio=ratio)
+    assert exact == pytest.approx(float(np.mean([c.rate for c in chains])), rel=1e-8)
+
+
+def test_table7_window_is_the_errata_rotation_vector():
+    from strapdown.algorithms import _reference
+    from strapdown.algorithms.errata import triple_cross_rotation_vectors
+    from strapdown.analysis.frequency_response import table7_window
+
+    theta = np.random.default_rng(7).normal(size=(3, 3)) * 0.1
+    for triple in (True, False):
+        w = table7_window(triple=triple)
+        x = [tuple(r) for r in theta]
+        phi = _reference.windowed_rotvec(x, list(w.weights), list(w.pairs), 0.0)
+        phi = _reference.add_triples(x, 0, list(w.triples), phi)
+        assert np.allclose(phi, triple_cross_rotation_vectors(theta, triple=triple)[0],
+                           rtol=0, atol=1e-15)

@@ -11,6 +11,10 @@ of ``A``. The drift about the cone axis is therefore exactly
 
     drift = Δ n_x / T,
 
+and the same holds with body spin ``ω_s`` about the body x axis
+(:class:`~strapdown.truth.motions.SpinConing`): the body-frame inputs then turn by
+``(Ω − ω_s) T`` per update, ``ρ = exp(x̂ (Ω − ω_s) T/2)`` in ``A``, and ``Δ = ψ − ΩT`` still.
+
 an exact function of ``a`` and ``Ωh`` for any coefficients, structure or triple terms:
 this module forms ``E`` from one update's exact inputs (the closed-form increments or
 rates of :class:`~strapdown.truth.motions.ClassicalConing`) in arbitrary precision and
@@ -32,13 +36,14 @@ from strapdown._core.backend import MPMATH
 from strapdown._core.validation import positive, positive_int
 from strapdown.algorithms import _reference
 from strapdown.algorithms.coning import WindowedAlgorithm
+from strapdown.algorithms.errata import TABLE7
 from strapdown.algorithms.finite_amplitude import triple_terms
 from strapdown.algorithms.rate import WindowedRateFamily
 from strapdown.algorithms.spec import AlgorithmSpec
 from strapdown.algorithms.structures import single_chain_coefficients
-from strapdown.truth.motions import ClassicalConing
+from strapdown.truth.motions import ClassicalConing, SpinConing
 
-__all__ = ["UpdateWindow", "classical_coning_drift", "update_window"]
+__all__ = ["UpdateWindow", "classical_coning_drift", "table7_window", "update_window"]
 
 
 @dataclass(frozen=True)
@@ -107,13 +112,26 @@ def update_window(algorithm: AlgorithmSpec | WindowedAlgorithm | UpdateWindow,
                      "rotation-invariant windowed algorithm")
 
 
+def table7_window(*, triple: bool = True) -> UpdateWindow:
+    """Zhang & Yu (2021) Table 7 (from Wang et al. (2015)) in the structure inferred by
+    :func:`strapdown.algorithms.errata.triple_cross_rotation_vectors`:
+    ``φ = Σθ + k11 θ1×θ3 + k12 θ2×(θ3 − θ1) + Σ k_mij θm × (θi × θj)``, three increments
+    per update (``triple=False``: without the triple terms)."""
+    k = TABLE7
+    pairs = ((0, 2, k["k11"]), (1, 2, k["k12"]), (0, 1, k["k12"]))  # θ2×(−θ1) = θ1×θ2
+    nodes = {"12": (0, 1), "23": (1, 2), "13": (0, 2)}
+    tri = tuple((m, *nodes[ij], k[f"k{m + 1}{ij}"]) for ij in nodes for m in range(3)
+                if k[f"k{m + 1}{ij}"] != 0.0) if triple else ()
+    return UpdateWindow("increment", 3, (0, 1, 2), (1.0, 1.0, 1.0), pairs, tri)
+
+
 def _num(v):
     if isinstance(v, Fraction):
         return mpmath.mpf(v.numerator) / v.denominator
     return mpmath.mpf(v)
 
 
-def _increment_quaternion(w: UpdateWindow, motion: ClassicalConing, h):
+def _increment_quaternion(w: UpdateWindow, motion: ClassicalConing | SpinConing, h):
     """``E`` of the update starting at t = 0 (exact inputs from the closed form)."""
     if w.rk4 is not None:
         stride = w.update
@@ -136,7 +154,7 @@ def _increment_quaternion(w: UpdateWindow, motion: ClassicalConing, h):
 
 def classical_coning_drift(algorithm: AlgorithmSpec | WindowedAlgorithm | UpdateWindow,
                            half_angle: float, omega_h: float, *, cone_rate: float = 1.0,
-                           digits: int = 50, triples=()) -> float:
+                           digits: int = 50, triples=(), spin_ratio: float = 0.0) -> float:
     """Exact drift about the cone axis (rad/s) under classical coning: ``Δ n_x / T``.
 
     Parameters
@@ -151,6 +169,9 @@ def classical_coning_drift(algorithm: AlgorithmSpec | WindowedAlgorithm | Update
         ``Ω`` (rad/s); the drift scales with it at fixed ``Ωh``.
     digits : int
         Working precision (significant digits, ≥ 17).
+    spin_ratio : float
+        Body spin rate over cone rate, ``ω_s/Ω`` (0: classical coning; otherwise the motion
+        of :class:`~strapdown.truth.motions.SpinConing`).
 
     Returns
     -------
@@ -171,10 +192,13 @@ def classical_coning_drift(algorithm: AlgorithmSpec | WindowedAlgorithm | Update
         if abs(mpmath.sin(half)) < 1e-12:  # (to the float64 resolution of omega_h)
             raise ValueError(f"Ω T = {float(2 * half):.6g} is a multiple of 2π: the cone "
                              "rotates whole turns per update and the drift is not defined")
-        motion = ClassicalConing(half_angle, 1.0)
+        spin = float(spin_ratio)
+        motion = (ClassicalConing(half_angle, 1.0) if spin == 0.0
+                  else SpinConing(half_angle, 1.0, spin))
         e = _increment_quaternion(w, motion, x)
         qa = motion.attitude_mp(mpmath.mpf(0))
-        rho = (mpmath.cos(half), mpmath.sin(half), mpmath.mpf(0), mpmath.mpf(0))
+        turn = half * (1 - mpmath.mpf(spin))  # (Ω − ω_s) T / 2: the inputs' turn per update
+        rho = (mpmath.cos(turn), mpmath.sin(turn), mpmath.mpf(0), mpmath.mpf(0))
         a = _reference.quat_mul(_reference.quat_mul(qa, _reference.quat_mul(e, rho)),
                                 (qa[0], -qa[1], -qa[2], -qa[3]))
         v = mpmath.sqrt(a[1] ** 2 + a[2] ** 2 + a[3] ** 2)
