@@ -107,6 +107,7 @@ _EXPORTS = {
     "EvaluationConfig": "strapdown.analysis.evaluate",
     # input
     "read_imu": "strapdown.io",
+    "InputError": "strapdown._core.errors",
 }
 #: Subpackages reachable as attributes (``strapdown.rotation``, ``strapdown.motions`` …).
 _MODULES = {

@@ -190,7 +190,8 @@ def test_truth_start_round_off_and_npy_truth(tmp_path):
 
 @pytest.mark.parametrize(("name", "write", "msg"), [
     ("bad.npy", lambda p: np.save(p, np.zeros((5, 4))), r"shape \(n, 5\)"),
-    ("bad.csv", lambda p: p.write_bytes(b"\x93NUMPY\x00\xff binary"), "not a text CSV"),
+    ("bad.csv", lambda p: p.write_bytes(b"\x93NUMPY\x00\xff binary"),
+     "not UTF-8 text .* expected a CSV"),
     ("bad.mat", lambda p: p.write_text("x"), "unknown truth format '.mat'"),
     ("back.csv", lambda p: p.write_text("t,qw,qx,qy,qz\n0,1,0,0,0\n0,1,0,0,0\n"),
      "times must increase strictly; row 2"),

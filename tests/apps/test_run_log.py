@@ -86,13 +86,14 @@ def test_unit_warning_is_an_error_unless_accepted(tmp_path, capsys):
     assert any("more likely in degrees" in w for w in meta["warnings"])
 
 
-@pytest.mark.filterwarnings("ignore::RuntimeWarning")  # 1e300 overflows on purpose
-def test_non_finite_result_fails_and_writes_nothing(tmp_path, capsys):
-    # 1e300 rad/s overflows the RK4 step: the attitude is inf/NaN from the first update on
+def test_rate_beyond_any_integrable_motion_fails_and_writes_nothing(tmp_path, capsys):
+    # 1e300 rad/s used to overflow the RK4 step (an inf/NaN attitude, refused at the output);
+    # it is now refused as input: 1e297 rad in one sample, the limit is π
     log = _write(tmp_path / "log.csv", "t,gx,gy,gz", T[:20], np.tile([1e300, 0, 0], (20, 1)))
     _fails(capsys, ["run", "--imu", str(log), "--rates", "--units", "rad/s", "--algorithm",
                     "rk4", "--accept-unit-warning", "--out", str(tmp_path / "a.csv")],
-           "the rk4 attitude is NaN or infinite from output row 2", tmp_path, ["log.csv"])
+           "data row 1 turns the body by 1e+297 rad in one sample (at most π)", tmp_path,
+           ["log.csv"])
 
 
 def _broad(path, gyro, fs):

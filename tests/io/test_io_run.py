@@ -9,6 +9,7 @@ import pytest
 from scipy.io import savemat
 
 from conftest import BROAD
+from strapdown import InputError
 from strapdown.algorithms.coning import coefficient_set
 from strapdown.algorithms.structures import conventional, realtime
 from strapdown.apps.run import run_log
@@ -127,7 +128,9 @@ def test_broad_recording_reads_and_runs(tmp_path):
     with np.load(tmp_path / "broad.npz") as z:
         q = np.column_stack([z["qw"], z["qx"], z["qy"], z["qz"]])
     assert np.allclose(np.linalg.norm(q, axis=1), 1.0, atol=1e-12)
-    with pytest.warns(UnitWarning):  # the same recording in deg/s, declared as rad/s
+    # the same recording in deg/s, declared as rad/s: the unit warning, then an error since
+    # a sample turns the body by more than π (the log cannot be integrated)
+    with pytest.warns(UnitWarning), pytest.raises(InputError, match="turns the body by"):
         read_imu(_as_degrees(path, tmp_path), kind="rate", units="rad/s")
 
 

@@ -95,7 +95,8 @@ def test_psins_layout_holds_increments(tmp_path):
 
 
 def test_unit_check_can_be_an_error(tmp_path):
-    path = _csv(tmp_path / "log.csv", "t,gx,gy,gz", T, np.degrees(W) * 300)
+    # deg/s declared as rad/s: ~1150 "rad/s", 1.15 rad a sample (integrable, implausible)
+    path = _csv(tmp_path / "log.csv", "t,gx,gy,gz", T, np.degrees(W))
     with pytest.warns(UnitWarning, match="more likely in degrees"):
         read_imu(path, kind="rate", units="rad/s")
     with pytest.raises(ValueError, match=r"more likely in degrees .* --accept-unit-warning"):

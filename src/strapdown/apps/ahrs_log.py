@@ -39,6 +39,7 @@ from typing import Any
 
 import numpy as np
 
+from strapdown._core.errors import InputError, shown
 from strapdown.ahrs import AhrsConfig, AhrsResult, MeasurementFlag, ekf
 from strapdown.algorithms.rate import resample_uniform
 from strapdown.apps._logs import output_with_sidecar, rate_records, unit_action
@@ -49,15 +50,22 @@ from strapdown.io.readers import (
     MAG_COLUMNS,
     ImuLog,
     UnitAction,
+    check_motion,
+    check_read_options,
     default_columns,
+    input_file,
     time_scale,
 )
 
-__all__ = ["ACC_UNITS", "BIAS_LIMIT", "DEFAULT_COLUMNS", "GYRO_UNITS", "AhrsLog", "read_ahrs_log",
-           "run_ahrs"]
+__all__ = ["ACC_LIMIT", "ACC_UNITS", "BIAS_LIMIT", "DEFAULT_COLUMNS", "GYRO_UNITS", "MAG_LIMIT",
+           "AhrsLog", "read_ahrs_log", "run_ahrs"]
 
 #: The column layout of an AHRS CSV written without a mapping (any recognised names work).
 DEFAULT_COLUMNS = ("t", "gx", "gy", "gz", "ax", "ay", "az", "mx", "my", "mz")
+#: Largest accelerometer norm accepted (m/s², 1000 g): no accelerometer reads more.
+ACC_LIMIT = 1000 * 9.80665
+#: Largest magnetometer norm accepted, in the file's unit (any: µT, nT, gauss).
+MAG_LIMIT = 1e12
 #: Largest plausible gyro-bias estimate (rad/s, ≈ 57 °/s): beyond it the filter diverged.
 BIAS_LIMIT = 1.0
 GYRO_UNITS = ("rad/s", "deg/s")
@@ -83,72 +91,93 @@ def _unit(path: Path, what: str, option: str, allowed, declared, found, whose) -
     """The unit of one sensor: the file's (header, format) or the declared one."""
     if found is not None:
         if found not in allowed:
-            raise ValueError(f"{path}: the {what} is in {found!r}; use one of {allowed}")
+            raise InputError(f"{path}: the {what} is in {found!r}; use one of {allowed}")
         if declared is not None and declared != found:
-            raise ValueError(f"{path}: declared {what} units {declared!r} contradict {whose[0]} "
+            raise InputError(f"{path}: declared {what} units {declared!r} contradict {whose[0]} "
                              f"{found!r}{whose[1]}")
         return found
     if declared is None:
-        raise ValueError(f"{path}: no {what} units declared; pass {option} "
+        raise InputError(f"{path}: no {what} units declared; pass {option} "
                          f"({' or '.join(allowed)}) or write them in the header "
                          f"(e.g. {'gx[deg/s]' if what == 'gyro' else 'ax[g]'})")
     if declared not in allowed:
-        raise ValueError(f"{what} units must be one of {allowed}, got {declared!r}")
+        raise InputError(f"{what} units must be one of {allowed}, got {declared!r}")
     return declared
 
 
-def _csv(path: Path, columns):
+def _csv(path: Path, columns, delimiter: str | None):
     """``(t [s], gyro, acc, mag or None, header units of gyro and acc)``."""
     if columns is None:
         axes, mag = default_columns(path, [("gyro", GYRO_COLUMNS),
-                                           ("accelerometer", ACC_COLUMNS)], optional=MAG_COLUMNS)
+                                           ("accelerometer", ACC_COLUMNS)], optional=MAG_COLUMNS,
+                                    delimiter=delimiter)
         columns = axes + mag
     elif len(columns) not in (7, 10):
-        raise ValueError(f"columns must name t, 3 gyro, 3 accelerometer and optionally 3 "
+        raise InputError(f"columns must name t, 3 gyro, 3 accelerometer and optionally 3 "
                          f"magnetometer columns, got {len(columns)}")
-    raw, units, have_mag = csv_columns(path, list(columns[:7]), optional=list(columns[7:10]))
+    raw, units, have_mag = csv_columns(path, list(columns[:7]), optional=list(columns[7:10]),
+                                       delimiter=delimiter)
     found = {}
     for what, cols in (("gyro", columns[1:4]), ("accelerometer", columns[4:7])):
         us = {units[c] for c in cols if c in units}
         if len(us) > 1:
-            raise ValueError(f"{path}: the header gives the {what} axes different units "
+            raise InputError(f"{path}: the header gives the {what} axes different units "
                              f"{sorted(us)}")
         found[what] = us.pop() if us else None
     t = raw[:, 0] * time_scale(path, columns[0], units)
     return t, raw[:, 1:4], raw[:, 4:7], raw[:, 7:10] if have_mag else None, found
 
 
-def read_ahrs_log(path, *, gyro_units: str | None = None, acc_units: str | None = None,
-                  columns=None, use_magnetometer: bool = True,
-                  sample_rate_hz: float | None = None, gap_tolerance: float = 1.5,
-                  unit_check: UnitAction = "warn") -> AhrsLog:
-    """Read and validate a recording (see the module docstring)."""
-    path = Path(path)
-    if not path.is_file():
-        raise ValueError(f"{path}: no such file")
-    if not gap_tolerance > 1:
-        raise ValueError(f"gap_tolerance is in sample intervals and must exceed 1, got "
-                         f"{gap_tolerance}")
-    nominal = None
+def _source(path: Path, columns, sample_rate_hz: float | None, delimiter: str | None):
+    """``(t, gyro, acc, mag, units found, whose, nominal period)`` of a BROAD .mat or a CSV."""
     if path.suffix.lower() == ".mat":
         from strapdown.io.broad import read_broad
 
         tr = read_broad(path)
         if sample_rate_hz is not None and not np.isclose(1 / tr.h, sample_rate_hz, rtol=1e-6):
-            raise ValueError(f"{path}: the file states a sampling rate of {1 / tr.h:g} Hz, not "
+            raise InputError(f"{path}: the file states a sampling rate of {1 / tr.h:g} Hz, not "
                              f"the {sample_rate_hz:g} Hz given")
-        t, g, a, m = tr.t, tr.gyro, tr.acc, tr.mag
-        found = _BROAD_UNITS
         whose = ("the file's", " (BROAD stores the gyro in rad/s, the accelerometer in m/s²)")
-    elif path.suffix.lower() == ".csv":
-        t, g, a, m, found = _csv(path, columns)
-        whose = ("the header's", "")
+        return tr.t, tr.gyro, tr.acc, tr.mag, _BROAD_UNITS, whose, None
+    if path.suffix.lower() in (".csv", ".txt", ".tsv"):
+        t, g, a, m, found = _csv(path, columns, delimiter)
         nominal = None if sample_rate_hz is None else 1.0 / sample_rate_hz
-    else:
-        raise ValueError(f"{path}: unsupported format (use a BROAD .mat or a CSV)")
+        return t, g, a, m, found, ("the header's", ""), nominal
+    raise InputError(f"{path}: unsupported format {shown(path.suffix, 20)} (use a BROAD .mat or "
+                     "a CSV)")
+
+
+def _check_range(path: Path, what: str, values: np.ndarray, limit: float, unit: str) -> None:
+    """Raise at the first row whose norm exceeds ``limit`` (no sensor reads that)."""
+    norm = np.hypot(np.hypot(values[:, 0], values[:, 1]), values[:, 2])
+    bad = ~(norm <= limit)
+    if np.any(bad):
+        i = int(np.argmax(bad))
+        raise InputError(f"{path}: the {what} in data row {i + 1} has norm {norm[i]:.4g} "
+                         f"{unit}, beyond any sensor's range ({limit:g} {unit}); check the "
+                         "units and the columns")
+
+
+def read_ahrs_log(path, *, gyro_units: str | None = None, acc_units: str | None = None,
+                  columns=None, use_magnetometer: bool = True,
+                  sample_rate_hz: float | None = None, gap_tolerance: float = 1.5,
+                  unit_check: UnitAction = "warn", delimiter: str | None = None) -> AhrsLog:
+    """Read and validate a recording (see the module docstring).
+
+    Every problem is an :class:`~strapdown.InputError` naming the file: besides the checks
+    ``run`` makes (:func:`strapdown.io.read_imu`: finite rows, time steps, no sample turning
+    the body by more than π), an accelerometer norm above :data:`ACC_LIMIT` m/s² or a
+    magnetometer norm above :data:`MAG_LIMIT` (its own unit) is refused.
+    """
+    check_read_options(kind="rate", units=None, gap_tolerance=gap_tolerance, on_gap="report",
+                       saturation=None, sample_rate_hz=sample_rate_hz)
+    path = input_file(path, "recording")
+    t, g, a, m, found, whose, nominal = _source(path, columns, sample_rate_hz, delimiter)
     gu = _unit(path, "gyro", "--gyro-units", GYRO_UNITS, gyro_units, found["gyro"], whose)
     au = _unit(path, "accelerometer", "--acc-units", ACC_UNITS, acc_units,
                found["accelerometer"], whose)
+    if t.size < 2:
+        raise InputError(f"{path}: {t.size} samples; at least 2 are needed")
     check_rows(path, t, [("time", [t]), ("gyro", [g]), ("accelerometer", [a]),
                          *((("magnetometer", [m]),) if m is not None else ())])
     if gu == "deg/s":
@@ -156,10 +185,14 @@ def read_ahrs_log(path, *, gyro_units: str | None = None, acc_units: str | None 
     if au == "g":
         a = a * 9.80665
     warn_implausible_rate(path, g, gu, suggestion="deg/s", action=unit_check)
-    if m is not None and not np.any(m):
-        use_magnetometer = False
     d = np.diff(t)
     unit_h = nominal or float(np.median(d))
+    check_motion(path, g, "rate", unit_h)
+    _check_range(path, "accelerometer", a, ACC_LIMIT, "m/s²")
+    if m is not None:
+        _check_range(path, "magnetometer", m, MAG_LIMIT, "(its unit)")
+    if m is not None and not np.any(m):
+        use_magnetometer = False
     gaps = [int(i) + 2 for i in np.flatnonzero(d > gap_tolerance * unit_h)]
     return AhrsLog(t, np.ascontiguousarray(g), np.ascontiguousarray(a),
                    None if (m is None or not use_magnetometer) else np.ascontiguousarray(m),
@@ -175,7 +208,7 @@ def _check_output(res: AhrsResult, gyro_units: str) -> None:
            | ~np.all(np.isfinite(res.attitude_sigma), axis=1))
     if np.any(bad):
         i = int(np.argmax(bad))
-        raise ValueError(f"the filter diverged at output row {i + 1} (t = {float(res.t[i]):.6g} "
+        raise InputError(f"the filter diverged at output row {i + 1} (t = {float(res.t[i]):.6g} "
                          f"s): quaternion {res.q[i].tolist()}, gyro bias "
                          f"{res.gyro_bias[i].tolist()} rad/s (limit {BIAS_LIMIT:g}); nothing "
                          f"written. Are the gyro units right (declared {gyro_units})?")
@@ -223,30 +256,32 @@ def run_ahrs(imu, out, *, algorithm: str = "rate-single", frame: str = "ENU",
              acc_units: str | None = None, columns=None, use_magnetometer: bool = True,
              sample_rate_hz: float | None = None, on_gap: str = "report",
              gap_tolerance: float = 1.5, resample: bool = False,
-             accept_unit_warning: bool = False) -> tuple[AhrsResult, dict[str, Any]]:
+             accept_unit_warning: bool = False,
+             delimiter: str | None = None) -> tuple[AhrsResult, dict[str, Any]]:
     """Filter a recording and write the attitude, biases and metadata atomically.
 
     ``on_gap``: ``"split"`` filters each gap-free segment from the previous one's last
     attitude and bias (covariance reset; the motion during the gap is not observed);
     ``"report"`` and ``"error"`` fail at a gap. ``resample`` interpolates jittered gyro,
-    accelerometer and magnetometer samples onto the uniform grid.
+    accelerometer and magnetometer samples onto the uniform grid. ``delimiter``: a CSV's
+    (default: detected). Anything wrong with the input is an :class:`~strapdown.InputError`.
     """
     imu, out = Path(imu), Path(out)
     if out.resolve() == imu.resolve():
-        raise ValueError("--out must not be the input file")
+        raise InputError("--out must not be the input file")
     if out.suffix.lower() not in (".csv", ".npz"):
-        raise ValueError(f"{out}: output must be .csv or .npz")
+        raise InputError(f"{out}: output must be .csv or .npz")
     if on_gap not in ("report", "error", "split"):
-        raise ValueError(f"on_gap must be report, error or split, got {on_gap!r}")
+        raise InputError(f"on_gap must be report, error or split, got {shown(on_gap, 20)}")
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         log = read_ahrs_log(imu, gyro_units=gyro_units, acc_units=acc_units, columns=columns,
                             use_magnetometer=use_magnetometer, sample_rate_hz=sample_rate_hz,
                             gap_tolerance=gap_tolerance,
-                            unit_check=unit_action(accept_unit_warning))
+                            unit_check=unit_action(accept_unit_warning), delimiter=delimiter)
         if log.gaps and on_gap == "error":
             r = log.gaps[0]
-            raise ValueError(f"{imu}: gap of {log.t[r - 1] - log.t[r - 2]:.6g} s before data "
+            raise InputError(f"{imu}: gap of {log.t[r - 1] - log.t[r - 2]:.6g} s before data "
                              f"row {r}")
         res, seg, base = _filter(imu, log, algorithm, frame, config, on_gap == "split",
                                  resample)

@@ -38,6 +38,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from strapdown._core.errors import InputError, shown
 from strapdown._core.kinds import InputKind
 from strapdown.algorithms.spec import AlgorithmSpec, parse_spec
 from strapdown.analysis.evaluate import EvaluationConfig, evaluate
@@ -80,7 +81,7 @@ def compare_motion(base: EvaluationConfig, specs: Iterable[str], out: str | os.P
     """Run every spec on ``base``'s motion and sensor; write the figure and tables to ``out``."""
     specs = list(specs)
     if not specs:
-        raise ValueError("give at least one algorithm spec")
+        raise InputError("give at least one algorithm spec")
     runs, notes = [], []
     for spec in specs:
         cfg = dataclasses.replace(base, **parse_spec(spec))
@@ -111,71 +112,58 @@ _TRUTH_COLUMNS = ("t", "qw", "qx", "qy", "qz")
 _TRUTH_FORMATS = "CSV with columns t,qw,qx,qy,qz, .npy of shape (n, 5) or .npz with t,qw,qx,qy,qz"
 
 
-def _read_truth(path: str | os.PathLike[str]
+def _read_truth(path: str | os.PathLike[str], delimiter: str | None = None
                 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """``(t, q)`` of a truth file (:data:`_TRUTH_FORMATS`), checked by :func:`_check_truth`."""
-    path = Path(path)
-    if not path.is_file():
-        raise ValueError(f"{path}: no such truth file")
+    """``(t, q)`` of a truth file (:data:`_TRUTH_FORMATS`), checked by :func:`_check_truth`;
+    binary files are read by :mod:`strapdown.io.containers` (structure validated first)."""
+    from strapdown.io.containers import open_npy, read_npz
+    from strapdown.io.readers import csv_columns, input_file, time_scale
+
+    path = input_file(path, "truth file")
     suffix = path.suffix.lower()
     if suffix == ".npz":
-        t, q = _read_truth_npz(path)
+        z = read_npz(path, _TRUTH_COLUMNS)
+        missing = [k for k in _TRUTH_COLUMNS if k not in z.arrays]
+        if missing:
+            raise InputError(f"{path}: truth needs arrays t, qw, qx, qy, qz; missing {missing} "
+                             f"(found {z.found()})")
+        cols = [z.arrays[k].astype(float).ravel() for k in _TRUTH_COLUMNS]
+        if len({c.size for c in cols}) != 1:
+            raise InputError(f"{path}: arrays t, qw, qx, qy, qz differ in length "
+                             f"{[c.size for c in cols]}")
+        t, q = cols[0], np.column_stack(cols[1:])
     elif suffix == ".npy":
-        try:
-            arr = np.load(path, allow_pickle=False)
-        except ValueError as exc:
-            raise ValueError(f"{path}: not a readable .npy array ({exc})") from None
-        if arr.ndim != 2 or arr.shape[1] != 5 or arr.dtype.kind not in "fiu":
-            raise ValueError(f"{path}: a .npy truth is a numeric array of shape (n, 5) with "
+        arr = open_npy(path)
+        if arr.ndim != 2 or arr.shape[1] != 5:
+            raise InputError(f"{path}: a .npy truth is a numeric array of shape (n, 5) with "
                              f"columns t, qw, qx, qy, qz; got {arr.dtype} {arr.shape}")
-        t, q = arr[:, 0].astype(float), arr[:, 1:].astype(float)
-    elif suffix in (".csv", ".txt"):
-        from strapdown.io.readers import csv_columns, time_scale
-
-        try:
-            raw, units, _ = csv_columns(path, _TRUTH_COLUMNS)
-        except UnicodeDecodeError:
-            raise ValueError(f"{path}: not a text CSV; truth must be {_TRUTH_FORMATS}") from None
+        t, q = np.asarray(arr[:, 0], float), np.asarray(arr[:, 1:], float)
+    elif suffix in (".csv", ".txt", ".tsv"):
+        raw, units, _ = csv_columns(path, _TRUTH_COLUMNS, delimiter=delimiter)
         t = raw[:, 0] * time_scale(path, "t", units)
         q = raw[:, 1:5]
     else:
-        raise ValueError(f"{path}: unknown truth format {path.suffix!r}; truth must be "
-                         f"{_TRUTH_FORMATS}")
+        raise InputError(f"{path}: unknown truth format {shown(path.suffix, 20)}; truth must "
+                         f"be {_TRUTH_FORMATS}")
     _check_truth(path, t, q)
     return t, q
-
-
-def _read_truth_npz(path: Path) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    try:
-        z = np.load(path, allow_pickle=False)
-    except (ValueError, OSError) as exc:
-        raise ValueError(f"{path}: not a readable .npz archive ({exc})") from None
-    with z:
-        missing = [k for k in _TRUTH_COLUMNS if k not in z]
-        if missing:
-            raise ValueError(f"{path}: truth needs arrays t, qw, qx, qy, qz; missing {missing}")
-        cols = [np.asarray(z[k], dtype=float).ravel() for k in _TRUTH_COLUMNS]
-    if len({c.size for c in cols}) != 1:
-        raise ValueError(f"{path}: arrays t, qw, qx, qy, qz differ in length "
-                         f"{[c.size for c in cols]}")
-    return cols[0], np.column_stack(cols[1:])
 
 
 def _check_truth(path: Path, t: NDArray[np.float64], q: NDArray[np.float64]) -> None:
     """Two or more rows, finite, strictly increasing times, unit quaternions (±1e-3)."""
     if t.size < 2:
-        raise ValueError(f"{path}: truth needs at least two rows, has {t.size}")
+        raise InputError(f"{path}: truth needs at least two rows, has {t.size}")
     bad = np.flatnonzero(~(np.isfinite(t) & np.all(np.isfinite(q), axis=1)))
     if bad.size:
-        raise ValueError(f"{path}: NaN or infinity in truth row {bad[0] + 1}")
-    step = np.flatnonzero(np.diff(t) <= 0)
+        raise InputError(f"{path}: NaN or infinity in truth row {bad[0] + 1}")
+    step = np.flatnonzero(~(np.diff(t) > 0))
     if step.size:
-        raise ValueError(f"{path}: truth times must increase strictly; row {step[0] + 2} "
+        raise InputError(f"{path}: truth times must increase strictly; row {step[0] + 2} "
                          f"(t = {t[step[0] + 1]!r}) does not")
     norm = np.linalg.norm(q, axis=1)
     off = np.flatnonzero(np.abs(norm - 1.0) > 1e-3)
     if off.size:
-        raise ValueError(f"{path}: truth row {off[0] + 1} is not a unit quaternion (norm "
+        raise InputError(f"{path}: truth row {off[0] + 1} is not a unit quaternion (norm "
                          f"{norm[off[0]]:.6g}); columns are qw, qx, qy, qz (scalar first)")
 
 
@@ -217,7 +205,7 @@ def _common_times(ta: NDArray[np.float64], tb: NDArray[np.float64], tol: float
 def _log_spec(fields) -> AlgorithmSpec:
     spec = AlgorithmSpec(**fields)
     if spec.family.stepped:
-        raise ValueError(f"{spec.algorithm} runs on reference motions only (its input is the "
+        raise InputError(f"{spec.algorithm} runs on reference motions only (its input is the "
                          "Krylov model's increments at thirds or halves of a step); use rotvec "
                          "or a rate algorithm on a log")
     return spec
@@ -246,26 +234,28 @@ def compare_log(imu: str | os.PathLike[str], specs: Iterable[str], out: str | os
                 sample_rate_hz: float | None = None, truth: str | os.PathLike[str] | None = None,
                 progress: Callable[[str], None] | None = None, on_gap: str = "report",
                 gap_tolerance: float = 1.5, resample: bool = False,
-                accept_unit_warning: bool = False) -> list[AlgorithmRun]:
+                accept_unit_warning: bool = False,
+                delimiter: str | None = None) -> list[AlgorithmRun]:
     """Run every spec on one gyro log and compare them (see the module docstring).
 
     The log is read as ``strapdown run`` reads it (:func:`strapdown.io.read_imu`; jittered
     rate stamps on their nominal period or ``resample``-d; ``on_gap="split"`` runs every
     spec over each gap-free segment from the previous one's last attitude; magnitudes that
-    suggest another unit are an error unless ``accept_unit_warning``).
+    suggest another unit are an error unless ``accept_unit_warning``; ``delimiter``: the
+    CSVs', default detected). Anything wrong with the inputs is an :class:`~strapdown.InputError`.
     """
     from strapdown.apps._logs import log_segments, unit_action
     from strapdown.io import read_imu
 
     specs = list(specs)
     if not specs:
-        raise ValueError("give at least one algorithm spec")
+        raise InputError("give at least one algorithm spec")
     fields = [parse_spec(s) for s in specs]
     if on_gap not in ("report", "error", "split"):
-        raise ValueError(f"on_gap must be report, error or split, got {on_gap!r}")
+        raise InputError(f"on_gap must be report, error or split, got {shown(on_gap, 20)}")
     log = read_imu(imu, kind=kind, units=units, columns=columns, sample_rate_hz=sample_rate_hz,
                    gap_tolerance=gap_tolerance, on_gap="error" if on_gap == "error" else "report",
-                   unit_check=unit_action(accept_unit_warning))
+                   unit_check=unit_action(accept_unit_warning), delimiter=delimiter)
     segments, base = log_segments(Path(imu), log, split=on_gap == "split", resample=resample,
                                   min_samples=max(_log_spec(f).min_samples for f in fields))
     h = segments[0].h
@@ -282,7 +272,7 @@ def compare_log(imu: str | os.PathLike[str], specs: Iterable[str], out: str | os
         time_base()
         _write(out, runs, title, what, progress, ylabel=ylabel, pairs=pairs)
         return runs
-    t_ref, q_ref = _read_truth(truth)
+    t_ref, q_ref = _read_truth(truth, delimiter)
     q0 = _truth_start(truth, t_ref, q_ref, log, tol)
     sols = [_run_on_log(segments, f, q0) for f in fields]
     name = Path(truth).name
@@ -310,7 +300,7 @@ def _truth_start(truth, t_ref: NDArray[np.float64], q_ref: NDArray[np.float64], 
 
     t_start = float(log.t[0]) - (log.h if log.kind == "increment" else 0.0)
     if not t_ref[0] - tol <= t_start <= t_ref[-1] + tol:
-        raise ValueError(f"{truth}: covers t = {t_ref[0]!r}…{t_ref[-1]!r} s, not the log's "
+        raise InputError(f"{truth}: covers t = {t_ref[0]!r}…{t_ref[-1]!r} s, not the log's "
                          f"start {t_start!r} s")
     t_start = min(max(t_start, float(t_ref[0])), float(t_ref[-1]))
     return quat_from_scipy(Slerp(t_ref, scipy_from_quat(q_ref))([t_start]))[0]

@@ -27,8 +27,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from tqdm import tqdm
 
+from strapdown._core.errors import InputError, shown
 from strapdown._core.kinds import InputKind
-from strapdown._core.validation import first_bad_step
 from strapdown.algorithms.family import StructureName
 from strapdown.algorithms.rotvec import Rotvec
 from strapdown.algorithms.spec import (
@@ -41,7 +41,16 @@ from strapdown.algorithms.streaming import RotvecStream
 from strapdown.algorithms.structures import increment_structure
 from strapdown.apps._logs import check_finite, output_with_sidecar, rate_records, unit_action
 from strapdown.io import read_imu
-from strapdown.io.readers import GapPolicy, GyroUnit, warn_implausible_rate
+from strapdown.io.readers import (
+    GapPolicy,
+    GyroUnit,
+    check_motion,
+    check_read_options,
+    check_steps,
+    input_file,
+    npy_log,
+    warn_implausible_rate,
+)
 from strapdown.rotation.cone_angles import cone_angles_from_quat
 from strapdown.rotation.dcm import dcm_from_quat
 from strapdown.rotation.euler import euler_zyx_from_dcm
@@ -84,19 +93,19 @@ def _header(angles: AngleOutput) -> str:
     return ",".join(names)
 
 
-def _npy_chunks(path: Path, units: GyroUnit, read: dict[str, Any], gaps: list[int],
-                saturated: list[int]
+def _npy_chunks(path: Path, arr: NDArray[Any], units: GyroUnit, read: dict[str, Any],
+                gaps: list[int], saturated: list[int]
                 ) -> Iterator[tuple[NDArray[np.float64], NDArray[np.float64]]]:
     """Validated (t, increments) chunks of an (n, 4) .npy log, memory-mapped.
 
-    Gaps (intervals over ``gap_tolerance`` times the nominal period, or the first interval
-    — a streamed log has no median) and saturated rows are appended to ``gaps`` and
-    ``saturated`` as the chunks go by; ``on_gap="error"`` raises at the first gap. The unit
-    plausibility check (``read["unit_check"]``) judges the first chunk.
+    The checks of :func:`strapdown.io.read_imu`, chunk by chunk: finite rows, time steps
+    (:func:`~strapdown.io.readers.check_steps`), no sample over π
+    (:func:`~strapdown.io.readers.check_motion`). Gaps (intervals over ``gap_tolerance``
+    times the nominal period, or the first interval — a streamed log has no median) and
+    saturated rows are appended to ``gaps`` and ``saturated`` as the chunks go by;
+    ``on_gap="error"`` raises at the first gap. The unit plausibility check
+    (``read["unit_check"]``) judges the first chunk.
     """
-    arr = np.load(path, mmap_mode="r")
-    if arr.ndim != 2 or arr.shape[1] != 4:
-        raise ValueError(f"{path}: .npy logs must be (n, 4) [t, gx, gy, gz], got {arr.shape}")
     scale = np.pi / 180.0 if units == "deg" else 1.0
     last = None
     h = None if read["sample_rate_hz"] is None else 1.0 / read["sample_rate_hz"]
@@ -104,24 +113,22 @@ def _npy_chunks(path: Path, units: GyroUnit, read: dict[str, Any], gaps: list[in
         c = np.array(arr[s:s + CHUNK], dtype=np.float64)
         bad = ~np.all(np.isfinite(c), axis=1)
         if np.any(bad):
-            raise ValueError(f"{path}: NaN or infinity in data row {s + int(np.argmax(bad)) + 1}")
+            raise InputError(f"{path}: NaN or infinity in data row {s + int(np.argmax(bad)) + 1}")
         t = c[:, 0] if last is None else np.concatenate([[last], c[:, 0]])
         d = np.diff(t)
         first = 1 if last is None else 0  # data row (1-based) of t[0] is s + first
-        fault = first_bad_step(d)
-        if fault is not None:
-            k, what = fault
-            raise ValueError(f"{path}: {what} time stamp in data row {s + k + first + 1}")
+        check_steps(path, d, t, s + first)
         if h is None and d.size:
             h = float(d[0])
         if h is not None:
             if last is None:
                 warn_implausible_rate(path, c[:, 1:] * (scale / h), units,
                                       action=read["unit_check"])
+            check_motion(path, c[:, 1:] * scale, "increment", h, s + 1)
             for i in np.flatnonzero(d > read["gap_tolerance"] * h):
                 row = s + int(i) + first + 1
                 if read["on_gap"] == "error":
-                    raise ValueError(f"{path}: gap of {d[i]:.6g} s ({d[i] / h:.1f} sample "
+                    raise InputError(f"{path}: gap of {d[i]:.6g} s ({d[i] / h:.1f} sample "
                                      f"intervals) before data row {row}")
                 gaps.append(row)
         if read["saturation"] is not None:
@@ -136,23 +143,23 @@ def _spec(kind: InputKind, algorithm: AlgorithmName | None, structure: Structure
     """The algorithm a log runs: by default rate-three for rates, rotvec for increments;
     options that do not apply to it are errors."""
     if kind not in ("rate", "increment"):
-        raise ValueError(f"kind must be 'rate' or 'increment', got {kind!r}")
+        raise InputError(f"kind must be 'rate' or 'increment', got {kind!r}")
     name: AlgorithmName = algorithm or DEFAULT_ALGORITHM[kind]
     spec = AlgorithmSpec(name, subsamples=3 if subsamples is None else subsamples,
                          coefficients=coefficients, structure=structure)
     if subsamples is not None and "subsamples" not in spec.family.options:
-        raise ValueError(f"--subsamples does not apply to {name} (only rotvec has subsamples "
+        raise InputError(f"--subsamples does not apply to {name} (only rotvec has subsamples "
                          "per update)")
     if spec.family.stepped:
-        raise ValueError(f"{name} runs on reference motions only (its input is the Krylov "
+        raise InputError(f"{name} runs on reference motions only (its input is the Krylov "
                          "model's increments at thirds or halves of a step)")
     if spec.input_kind == "increment" and kind != "increment":
-        raise ValueError(f"{name} takes increments (--increments); for rate logs use "
+        raise InputError(f"{name} takes increments (--increments); for rate logs use "
                          f"{', '.join(algorithms_taking('rate'))}")
     if spec.input_kind == "rate" and kind != "rate":
-        raise ValueError(f"{name} takes rate samples (--rates)")
+        raise InputError(f"{name} takes rate samples (--rates)")
     if not isinstance(spec.family, Rotvec) and spec.input_kind == "increment":
-        raise ValueError(f"{name} does not run on a log; use rotvec or "
+        raise InputError(f"{name} does not run on a log; use rotvec or "
                          f"{', '.join(algorithms_taking('rate'))}")
     return spec
 
@@ -166,7 +173,7 @@ def run_log(imu: str | os.PathLike[str], out: str | os.PathLike[str], *, kind: I
             q0: ArrayLike | None = None, on_gap: RunGapPolicy = "report",
             gap_tolerance: float = 1.5, saturation: float | None = None,
             progress: bool = False, resample: bool = False,
-            accept_unit_warning: bool = False) -> dict[str, Any]:
+            accept_unit_warning: bool = False, delimiter: str | None = None) -> dict[str, Any]:
     """Process a log and write ``out`` with its metadata sidecar ``OUT.meta.json``.
 
     Returns the metadata (input, algorithm, samples, outputs, update and sample period,
@@ -197,22 +204,34 @@ def run_log(imu: str | os.PathLike[str], out: str | os.PathLike[str], *, kind: I
         on it.
     accept_unit_warning : bool
         Run although magnitudes suggest another unit than declared (else an error).
+    delimiter : str, optional
+        A CSV's delimiter (default: detected from its header row).
+
+    Raises
+    ------
+    InputError
+        Anything wrong with the log or the options (every route, the streamed ``.npy``
+        too, by :func:`strapdown.io.read_imu`'s rules), or a non-finite or empty result.
     """
     imu_path, out_path = Path(imu), Path(out)
     if out_path.resolve() == imu_path.resolve():
-        raise ValueError("--out must not be the input file")
+        raise InputError("--out must not be the input file")
     if out_path.suffix.lower() not in (".csv", ".npz"):
-        raise ValueError(f"{out_path}: output must be .csv or .npz")
+        raise InputError(f"{out_path}: output must be .csv or .npz")
     if angles not in ANGLES:
-        raise ValueError(f"angles must be ypr, cone or none, got {angles!r}")
+        raise InputError(f"angles must be ypr, cone or none, got {shown(angles, 20)}")
     if on_gap not in RUN_GAP_POLICIES:
-        raise ValueError(f"on_gap must be report, error or split, got {on_gap!r}")
+        raise InputError(f"on_gap must be report, error or split, got {shown(on_gap, 20)}")
     spec = _spec(kind, algorithm, structure, subsamples, coefficients)
+    check_read_options(kind=kind, units=units, gap_tolerance=gap_tolerance, on_gap="report",
+                       saturation=saturation, sample_rate_hz=sample_rate_hz, columns=columns)
+    input_file(imu_path, "log file")
     if resample and kind != "rate":
-        raise ValueError("--resample applies to rate logs (--rates) only")
+        raise InputError("--resample applies to rate logs (--rates) only")
     read = {"kind": kind, "units": units, "columns": columns, "sample_rate_hz": sample_rate_hz,
             "gap_tolerance": gap_tolerance, "on_gap": "error" if on_gap == "error" else "report",
-            "saturation": saturation, "unit_check": unit_action(accept_unit_warning)}
+            "saturation": saturation, "unit_check": unit_action(accept_unit_warning),
+            "delimiter": delimiter}
     split = on_gap == "split"
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -253,12 +272,15 @@ def _increment_segments(imu: Path, read: dict[str, Any], split: bool):
     """``(total, gaps, saturated, units, h, segments)``: the log's chunks per segment."""
     if imu.suffix.lower() == ".npy" and not split:
         if read["units"] is None:
-            raise ValueError(f"{imu}: .npy logs carry no units; pass --units")
-        total = np.load(imu, mmap_mode="r").shape[0]
+            raise InputError(f"{imu}: .npy logs carry no units; pass --units")
+        arr = npy_log(imu)
+        total = arr.shape[0]
+        if total < 2:
+            raise InputError(f"{imu}: {total} samples; at least 2 are needed")
         gaps: list[int] = []
         saturated: list[int] = []
         segments: list[Iterator[tuple[NDArray[np.float64], NDArray[np.float64]]]] = [
-            _npy_chunks(imu, read["units"], read, gaps, saturated)]
+            _npy_chunks(imu, arr, read["units"], read, gaps, saturated)]
         h_given = None if read["sample_rate_hz"] is None else 1.0 / read["sample_rate_hz"]
         return total, gaps, saturated, read["units"], h_given, segments
     log = read_imu(imu, **read)
@@ -308,7 +330,10 @@ def _run_increments(imu: Path, tmp: Path, read: dict[str, Any], spec: AlgorithmS
                             parts.append(rows)
                         q_last = res.q[-1]
     if n_in == 0:
-        raise ValueError(f"{imu}: no samples")
+        raise InputError(f"{imu}: no samples")
+    if n_out == 0:
+        raise InputError(f"{imu}: {n_in} samples give no attitude update with {spec} (it "
+                         f"needs at least {spec.min_samples}); nothing written")
     if not csv_out:
         table = np.concatenate(parts) if parts else np.empty((0, len(names)))
         # Any: np.savez's column keywords share its signature with allow_pickle: bool

@@ -98,12 +98,15 @@ def main(argv: list[str] | None = None) -> int:
     try:
         args = parser.parse_args(sys.argv[1:] if argv is None else argv)
         prog = f"strapdown {args.command}"
-        if args.command in _NO_KERNELS:
-            return args.handler(args)
-        from strapdown._core.compile_notice import notice
+        from strapdown._core.limits import memory_budget
 
-        with notice(say):
-            return args.handler(args)
+        with memory_budget(getattr(args, "max_memory", None)):  # --max-memory, where it is
+            if args.command in _NO_KERNELS:
+                return args.handler(args)
+            from strapdown._core.compile_notice import notice
+
+            with notice(say):
+                return args.handler(args)
     except ValueError as exc:
         parser.exit(EXIT_USAGE, f"{prog}: error: {exc}\n")
     except KeyboardInterrupt as exc:  # a sweep's says how far it got

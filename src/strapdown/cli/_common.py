@@ -25,6 +25,7 @@ __all__ = [
     "algorithm_help",
     "coefficients_help",
     "columns",
+    "input_args",
     "json_arg",
     "log_args",
     "log_check_args",
@@ -33,6 +34,7 @@ __all__ = [
     "progress",
     "progress_args",
     "say",
+    "size",
     "structure_help",
 ]
 
@@ -179,12 +181,33 @@ def log_args(p: argparse.ArgumentParser, *, imu_help: str, required: bool,
                    help="CSV columns for time and the three axes, comma-separated, e.g. "
                    "time,wx,wy,wz (default: found in the header — time t, time, timestamp, "
                    "time_s, t[ms] …; axes gx,gy,gz, wx,wy,wz, gyro_x,… )")
+    input_args(g)
     if sample_rate:
         g.add_argument("--sample-rate-hz", type=float, default=None,
                        help="the sensor's sample rate (Hz): the nominal period of a rate log's "
                        "jittered time stamps, the increment interval of an increment log, the "
                        "time base of a log without time stamps (default: from the stamps or "
                        "the file's stated rate)")
+
+
+def input_args(g: Options, *, delimiter: bool = True) -> None:
+    """``--delimiter`` (with ``delimiter``: a CSV's, default detected) and ``--max-memory``
+    (the budget of what an input file may decode to; :mod:`strapdown._core.limits`)."""
+    if delimiter:
+        g.add_argument("--delimiter", default=None, choices=(",", ";", "tab", "|"),
+                       help="CSV delimiter (default: detected from the header row: the first "
+                       "of , ; tab | it contains)")
+    g.add_argument("--max-memory", default=None, type=size, metavar="SIZE",
+                   help="memory budget for what an input file decodes to, e.g. 512M or 8G; a "
+                   "file declaring more is refused before anything is allocated (default: "
+                   "$STRAPDOWN_MAX_BYTES, else 2G)")
+
+
+def size(text: str) -> int:
+    """``--max-memory``'s type: bytes of ``512M``, ``2G``, ``1e9`` (argparse reports a bad one)."""
+    from strapdown._core.limits import parse_size
+
+    return parse_size(text)
 
 
 def log_check_args(p: argparse.ArgumentParser, *, saturation: bool = True) -> None:

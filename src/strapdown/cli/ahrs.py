@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from strapdown.cli._common import columns, log_check_args, say
+from strapdown.cli._common import columns, input_args, log_check_args, say
 
 __all__ = ["add_parser", "run"]
 
@@ -46,6 +46,7 @@ def _arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--sample-rate-hz", type=float, default=None,
                    help="the sensor's sample rate (Hz): the nominal period of jittered time "
                    "stamps (default: from the stamps)")
+    input_args(p)
     log_check_args(p, saturation=False)
     p.add_argument("--no-mag", action="store_true", help="ignore the magnetometer")
     p.add_argument("--no-gating", action="store_true",
@@ -66,7 +67,8 @@ def run(args: argparse.Namespace) -> int:
                          columns=None if args.columns is None else columns(args.columns),
                          use_magnetometer=not args.no_mag, sample_rate_hz=args.sample_rate_hz,
                          on_gap=args.on_gap, gap_tolerance=args.gap_tolerance,
-                         resample=args.resample, accept_unit_warning=args.accept_unit_warning)
+                         resample=args.resample, accept_unit_warning=args.accept_unit_warning,
+                         delimiter=args.delimiter)
     for w in meta["warnings"]:
         say(f"warning: {w}")
     if meta["gaps"]["count"]:

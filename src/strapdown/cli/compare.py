@@ -43,6 +43,7 @@ def run(args: argparse.Namespace) -> int:
 
     if args.imu is None:
         log_only = (args.kind or args.truth or args.units or args.columns or args.resample
+                    or args.delimiter
                     or args.accept_unit_warning or args.on_gap != "report"
                     or args.gap_tolerance != 1.5)
         if log_only:
@@ -65,7 +66,7 @@ def run(args: argparse.Namespace) -> int:
             columns=None if args.columns is None else columns(args.columns),
             sample_rate_hz=args.sample_rate_hz, truth=args.truth, progress=say,
             on_gap=args.on_gap, gap_tolerance=args.gap_tolerance, resample=args.resample,
-            accept_unit_warning=args.accept_unit_warning)
+            accept_unit_warning=args.accept_unit_warning, delimiter=args.delimiter)
     for r in runs:
         print(f"{r.label:40s} max {r.summary['max_error_rad']:.3e} rad  "
               f"rms {r.summary['rms_error_rad']:.3e} rad")

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import argparse
 
-from strapdown.cli._common import columns, progress, progress_args, say
+from strapdown.cli._common import columns, input_args, progress, progress_args, say
 
 __all__ = ["add_parser", "run"]
 
@@ -49,6 +49,7 @@ def _arguments(p: argparse.ArgumentParser) -> None:
                    help="the sensor's sample rate (Hz), for files without time stamps")
     g.add_argument("--accept-unit-warning", action="store_true",
                    help="run although magnitudes suggest other units than declared")
+    input_args(g, delimiter=False)
     s = p.add_argument_group("initial state")
     s.add_argument("--init-lat", type=float, required=True, help="latitude (deg)")
     s.add_argument("--init-lon", type=float, required=True, help="longitude (deg)")

@@ -84,7 +84,7 @@ def run(args: argparse.Namespace) -> int:
                   sample_rate_hz=args.sample_rate_hz, angles=args.angles, on_gap=args.on_gap,
                   gap_tolerance=args.gap_tolerance, saturation=args.saturation,
                   progress=progress(args), resample=args.resample,
-                  accept_unit_warning=args.accept_unit_warning)
+                  accept_unit_warning=args.accept_unit_warning, delimiter=args.delimiter)
     for w in res["warnings"]:
         say(f"warning: {w}")
     gaps, saturated = res["gaps"], res["saturated"]

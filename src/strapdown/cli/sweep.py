@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from strapdown.cli._common import progress, progress_args, say
+from strapdown.cli._common import input_args, progress, progress_args, say
 
 __all__ = ["INCOMPLETE", "add_parser", "run"]
 
@@ -40,6 +40,7 @@ def _arguments(p: argparse.ArgumentParser) -> None:
                    help="table formats, comma-separated: csv, parquet")
     p.add_argument("--max-cases", type=int, default=None,
                    help="compute at most this many new cases, then stop")
+    input_args(p, delimiter=False)
     progress_args(p)
 
 

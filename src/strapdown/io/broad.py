@@ -12,10 +12,12 @@ from __future__ import annotations
 
 import os
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
+
+from strapdown._core.errors import InputError
+from strapdown.io.containers import read_mat
 
 __all__ = ["BroadTrial", "read_broad"]
 
@@ -38,20 +40,26 @@ class BroadTrial:
 
 
 def read_broad(path: str | os.PathLike[str]) -> BroadTrial:
-    """Load a BROAD ``.mat`` trial; errors name what is missing."""
-    from scipy.io import loadmat
+    """Load a BROAD ``.mat`` trial (read by :func:`strapdown.io.containers.read_mat`, which
+    validates the file's structure first); errors name the file and what is missing."""
+    from strapdown.io.readers import file_rate, input_file
 
-    path = Path(path)
-    if not path.is_file():
-        raise ValueError(f"{path}: no such file")
-    m = loadmat(path)
+    path = input_file(path, "BROAD trial (.mat)")
     need = ("imu_gyr", "imu_acc", "imu_mag", "opt_quat", "movement", "sampling_rate")
+    c = read_mat(path, need)
+    m = c.arrays
     missing = [k for k in need if k not in m]
     if missing:
-        raise ValueError(f"{path}: not a BROAD trial (missing {missing})")
-    fs = float(np.squeeze(m["sampling_rate"]))
-    g = np.asarray(m["imu_gyr"], float)
+        raise InputError(f"{path}: not a BROAD trial (missing {missing}; found {c.found()})")
+    fs = file_rate(path, m["sampling_rate"])
+    assert fs is not None
+    g = m["imu_gyr"]
     n = g.shape[0]
-    return BroadTrial(path.stem, np.arange(n) / fs, g, np.asarray(m["imu_acc"], float),
-                      np.asarray(m["imu_mag"], float), np.asarray(m["opt_quat"], float),
-                      np.asarray(m["movement"], float).reshape(-1) > 0)
+    for k in ("imu_gyr", "imu_acc", "imu_mag", "opt_quat"):
+        want = 4 if k == "opt_quat" else 3
+        if m[k].ndim != 2 or m[k].shape != (n, want):
+            raise InputError(f"{path}: {k} must have shape ({n}, {want}), got {m[k].shape}")
+    if m["movement"].size != n:
+        raise InputError(f"{path}: movement must have {n} values, got {m['movement'].size}")
+    return BroadTrial(path.stem, np.arange(n) / fs, g, m["imu_acc"], m["imu_mag"],
+                      m["opt_quat"], m["movement"].reshape(-1) > 0)

@@ -10,6 +10,8 @@ CSV columns are mapped by name: given (``--columns time,wx,wy,wz``), or found in
 header — the time column among :data:`TIME_COLUMNS` (``t``, ``time``, ``timestamp``,
 ``time_s`` …, case-insensitive), the axes among :data:`GYRO_COLUMNS` (``gx,gy,gz``,
 ``wx,wy,wz`` …). A time column in other units than seconds says so (``t[ms]``, ``time_us``).
+A UTF-8 byte-order mark, CRLF line ends and ``;``, tab or ``|`` delimiters (given, or
+detected from the header row: :data:`DELIMITERS`) are read as plainly as commas.
 
 Every log declares what it holds: rates or increments, and the unit (``rad/s``/``deg/s``
 for rates, ``rad``/``deg`` for increments), by argument or by the file: a CSV header's
@@ -23,12 +25,19 @@ more likely deg/s). Validation raises on NaN or infinity, duplicated or non-mono
 stamps (with the row number, counting the first data row as 1), reports gaps larger than
 ``gap_tolerance`` sample intervals (or raises, ``on_gap="error"``; :meth:`ImuLog.segments`
 splits at them) and reports rows at or above a declared saturation level.
+
+Anything wrong with a file or an option is an :class:`~strapdown.InputError` (a
+``ValueError``) naming the file and what was expected, its message bounded in length. The
+binary formats are read by :mod:`strapdown.io.containers`, which validates their structure
+before decoding anything and checks declared sizes against the file and the memory budget
+(:mod:`strapdown._core.limits`). Physical limits apply to every route: time steps of at
+least :data:`MIN_PERIOD`, a sample period up to :data:`MAX_PERIOD`, and no sample turning
+the body by more than :data:`MAX_SAMPLE_ANGLE` (π).
 """
 
 from __future__ import annotations
 
 import csv
-import io as _io
 import itertools
 import math
 import os
@@ -42,16 +51,25 @@ from typing import Any, Literal, get_args
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from strapdown._core.errors import InputError, shown
 from strapdown._core.kinds import INPUT_KINDS, InputKind
+from strapdown._core.limits import check_bytes
 from strapdown._core.validation import first_bad_step
+from strapdown.io.containers import open_npy, read_hdf5, read_mat, read_npz
 from strapdown.io.files import atomic_path
 
 __all__ = [
     "ACC_COLUMNS",
+    "DELIMITERS",
     "GAP_POLICIES",
     "GYRO_COLUMNS",
     "INCREMENT_UNITS",
     "MAG_COLUMNS",
+    "MAX_HEADER_CHARS",
+    "MAX_PERIOD",
+    "MAX_SAMPLE_ANGLE",
+    "MIN_PERIOD",
+    "PSINS_VARIABLES",
     "RATE_PLAUSIBLE_MAX",
     "RATE_UNITS",
     "TIME_COLUMNS",
@@ -66,10 +84,16 @@ __all__ = [
     "UnitAction",
     "UnitWarning",
     "canonical_unit",
+    "check_motion",
+    "check_read_options",
     "check_rows",
+    "check_steps",
     "csv_columns",
     "csv_header",
     "default_columns",
+    "file_rate",
+    "input_file",
+    "npy_log",
     "read_imu",
     "time_scale",
     "warn_implausible_rate",
@@ -186,19 +210,70 @@ def _split_header(cells):
     return names, units
 
 
-def csv_header(path: str | os.PathLike[str]) -> tuple[list[str], dict[str, str]]:
-    """The column names of a CSV's header row and the units it declares by name."""
+#: Delimiters a CSV may use: given (``--delimiter``) or detected from the header row (the
+#: first of these it contains; none: a single column).
+DELIMITERS = (",", ";", "\t", "|")
+#: Longest header row read (characters): a longer first line is not a CSV header.
+MAX_HEADER_CHARS = 65536
+
+
+def _delimiter(path: Path, line: str, given: str | None) -> str:
+    if given is not None:
+        d = {"tab": "\t", "\\t": "\t", "comma": ",", "semicolon": ";"}.get(given, given)
+        if d not in DELIMITERS:
+            raise InputError(f"--delimiter must be one of , ; tab |, got {shown(given, 20)}")
+        return d
+    return next((d for d in DELIMITERS if d in line), ",")
+
+
+def _bad_bytes(exc: UnicodeDecodeError) -> str:
+    return f"bytes {shown(exc.object[exc.start:exc.start + 8], 40)}"
+
+
+def _header_line(path: Path, f, delimiter: str | None) -> tuple[list[str], str]:
+    """The header row's cells and the delimiter, from a text file opened by :func:`_text`."""
+    try:
+        line = f.readline(MAX_HEADER_CHARS + 1)
+    except UnicodeDecodeError as exc:
+        raise InputError(f"{path}: not UTF-8 text ({_bad_bytes(exc)}); expected a CSV log"
+                         ) from None
+    if not line.strip():
+        raise InputError(f"{path}: {'empty file' if not line else 'the header row is empty'}; "
+                         "expected a CSV with a header row")
+    if len(line) > MAX_HEADER_CHARS:
+        raise InputError(f"{path}: the header row is longer than {MAX_HEADER_CHARS} characters; "
+                         "expected a CSV with a header row")
+    d = _delimiter(path, line, delimiter)
+    try:
+        cells = next(csv.reader([line.rstrip("\r\n")], delimiter=d))
+    except (csv.Error, StopIteration) as exc:
+        raise InputError(f"{path}: unreadable header row ({exc})") from None
+    return cells, d
+
+
+def _text(path: Path):
+    """``path`` opened as UTF-8 text: a byte-order mark skipped, CRLF and CR read as LF."""
+    return open(path, encoding="utf-8-sig", newline=None)
+
+
+def csv_header(path: str | os.PathLike[str], *, delimiter: str | None = None
+               ) -> tuple[list[str], dict[str, str]]:
+    """The column names of a CSV's header row and the units it declares by name.
+
+    ``delimiter``: one of :data:`DELIMITERS` (``"tab"`` for a tab), or None to take the
+    first of them the header row contains. A UTF-8 byte-order mark and CRLF line ends are
+    read as plain text.
+    """
     path = Path(path)
-    with open(path, newline="", encoding="utf-8") as f:
-        try:
-            return _split_header(next(csv.reader(f)))
-        except StopIteration:
-            raise ValueError(f"{path}: empty file") from None
+    with _text(path) as f:
+        cells, _ = _header_line(path, f, delimiter)
+    return _split_header(cells)
 
 
 def default_columns(path: str | os.PathLike[str],
                     axes: Sequence[tuple[str, Sequence[tuple[str, str, str]]]],
-                    optional: Sequence[tuple[str, str, str]] = ()) -> tuple[list[str], list[str]]:
+                    optional: Sequence[tuple[str, str, str]] = (), *,
+                    delimiter: str | None = None) -> tuple[list[str], list[str]]:
     """The columns a header names without ``--columns``: ``([time, *axes], optional)``.
 
     The time column is the one header name among :data:`TIME_COLUMNS` (case-insensitive,
@@ -206,11 +281,11 @@ def default_columns(path: str | os.PathLike[str],
     candidate triples the header has, ``optional`` likewise (``[]`` when it has none).
     Errors name what is missing or ambiguous and the header.
     """
-    names, _ = csv_header(path)
+    names, _ = csv_header(path, delimiter=delimiter)
     times = [n for n in names if _TIME_NAME.match(n)]
     if len(times) != 1:
-        what = "no time column" if not times else f"several time columns {times}"
-        raise ValueError(f"{path}: {what} in the header {names} (recognised: "
+        what = "no time column" if not times else f"several time columns {shown(times, 80)}"
+        raise InputError(f"{path}: {what} in the header {shown(names, 160)} (recognised: "
                          f"{', '.join(TIME_COLUMNS)}, optionally with a unit, t[ms]); name the "
                          "columns with --columns")
     lower = {n.lower(): n for n in names}
@@ -225,9 +300,9 @@ def default_columns(path: str | os.PathLike[str],
     for label, candidates in axes:
         found = triple(candidates)
         if not found:
-            raise ValueError(f"{path}: no {label} columns in the header {names} (recognised: "
-                             f"{'; '.join(','.join(c) for c in candidates)}); name the columns "
-                             "with --columns")
+            raise InputError(f"{path}: no {label} columns in the header {shown(names, 160)} "
+                             f"(recognised: {'; '.join(','.join(c) for c in candidates)}); "
+                             "name the columns with --columns")
         cols += found
     return cols, triple(optional)
 
@@ -240,58 +315,89 @@ def time_scale(path: str | os.PathLike[str], name: str, units: dict[str, str]) -
     if unit is None:
         return 1.0
     if unit not in TIME_UNITS:
-        raise ValueError(f"{path}: time column {name!r} is in {unit!r}; known time units are "
-                         f"{', '.join(TIME_UNITS)}")
+        raise InputError(f"{path}: time column {shown(name, 40)} is in {shown(unit, 40)}; known "
+                         f"time units are {', '.join(TIME_UNITS)}")
     return TIME_UNITS[unit]
 
 
+def _csv_budget(path: Path, ncols: int) -> None:
+    """Refuse a CSV whose values would exceed the memory budget (rows estimated from the
+    mean length of the first 64 kiB of lines)."""
+    size = path.stat().st_size
+    with open(path, "rb") as f:
+        sample = f.read(65536)
+    mean = len(sample) / max(sample.count(b"\n"), 1)
+    check_bytes(path, int(size / mean + 1) * ncols * 8, "its values")
+
+
 def csv_columns(path: str | os.PathLike[str], columns: Sequence[str],
-                optional: Sequence[str] = ()) -> tuple[NDArray[np.float64], dict[str, str], bool]:
+                optional: Sequence[str] = (), *, delimiter: str | None = None
+                ) -> tuple[NDArray[np.float64], dict[str, str], bool]:
     """Named columns of a CSV log with a header row.
 
     Returns ``(values, units, have_optional)``: ``values`` holds ``columns``
     followed by ``optional`` when every optional column is present, ``units``
     the header's bracketed units by column name (``gx[deg/s]``). Errors name
     missing columns, a file without data rows, unreadable numbers and rows
-    whose field count differs from the header's.
+    whose field count differs from the header's. ``delimiter``: as :func:`csv_header`.
     """
     path = Path(path)
-    with open(path, newline="", encoding="utf-8") as f:
-        reader = csv.reader(f)
-        try:
-            header, units = _split_header(next(reader))
-        except StopIteration:
-            raise ValueError(f"{path}: empty file") from None
+    with _text(path) as f:
+        cells, d = _header_line(path, f, delimiter)
+        header, units = _split_header(cells)
         missing = [c for c in columns if c not in header]
         if missing:
-            raise ValueError(f"{path}: columns {missing} not in the header {header}; map them "
-                             "with --columns")
+            raise InputError(f"{path}: columns {shown(missing, 100)} not in the header "
+                             f"{shown(header, 160)}; map them with --columns")
         have_optional = bool(optional) and all(c in header for c in optional)
         wanted = list(columns) + (list(optional) if have_optional else [])
         idx = [header.index(c) for c in wanted]
-        text = f.read()
-    if not text.strip():
-        raise ValueError(f"{path}: no data rows")
-    try:
-        raw = np.loadtxt(_io.StringIO(text), delimiter=",", ndmin=2, dtype=np.float64)
-    except ValueError as exc:
-        raise ValueError(f"{path}: unreadable number ({exc})") from exc
-    if raw.shape[1] != len(header):
-        raise ValueError(f"{path}: rows have {raw.shape[1]} fields, the header {len(header)}")
+        _csv_budget(path, len(header))
+        raw = _csv_values(path, f, d, len(header))
     return raw[:, idx], units, have_optional
 
 
-def _load_csv(path: Path, columns):
+def _csv_values(path: Path, f, delimiter: str, ncols: int) -> NDArray[np.float64]:
+    """The data rows after the header, as numbers (every row with the header's fields)."""
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", UserWarning)  # "input contained no data"
+            raw = np.loadtxt(f, delimiter=delimiter, ndmin=2, dtype=np.float64)
+    except UnicodeDecodeError as exc:
+        raise InputError(f"{path}: not UTF-8 text ({_bad_bytes(exc)}); expected numbers"
+                         ) from None
+    except (ValueError, IndexError) as exc:
+        raise InputError(f"{path}: unreadable number ({shown(str(exc), 160)}); expected "
+                         f"{ncols} numbers separated by {delimiter!r} in every data row"
+                         ) from None
+    if raw.size == 0:
+        raise InputError(f"{path}: no data rows")
+    if raw.shape[1] != ncols:
+        raise InputError(f"{path}: rows have {raw.shape[1]} fields, the header {ncols}")
+    return raw
+
+
+def _load_csv(path: Path, columns, delimiter: str | None):
     """``(t [s], axes, header unit of the axes)``; ``columns`` None: :func:`default_columns`."""
     if columns is None:
-        columns, _ = default_columns(path, [("gyro", GYRO_COLUMNS)])
-    raw, units, _ = csv_columns(path, columns)
+        columns, _ = default_columns(path, [("gyro", GYRO_COLUMNS)], delimiter=delimiter)
+    raw, units, _ = csv_columns(path, columns, delimiter=delimiter)
     axis_units = {units[c] for c in columns[1:] if c in units}
     if len(axis_units) > 1:
-        raise ValueError(f"{path}: the header gives the axes different units {sorted(axis_units)}")
+        raise InputError(f"{path}: the header gives the axes different units "
+                         f"{shown(sorted(axis_units), 80)}")
     scale = time_scale(path, columns[0], units)
     t = raw[:, 0] * scale if scale != 1.0 else raw[:, 0]
     return t, raw[:, 1:4], (axis_units.pop() if axis_units else None)
+
+
+#: Shortest time step accepted (s): an IMU samples at most at 1 GHz.
+MIN_PERIOD = 1e-9
+#: Longest median sample period accepted (s, about a day).
+MAX_PERIOD = 1e5
+#: Largest rotation in one sample (rad): beyond π the samples cannot resolve the motion
+#: (Nyquist), and the units or the sample rate are wrong.
+MAX_SAMPLE_ANGLE = math.pi
 
 
 def check_rows(path: str | os.PathLike[str], t: NDArray[np.float64],
@@ -300,7 +406,8 @@ def check_rows(path: str | os.PathLike[str], t: NDArray[np.float64],
 
     ``groups``: ``(label, arrays)`` pairs checked in order; a row is bad when
     any array of the group is not finite there. Rows count from 1 (the first
-    data row); ``label`` None gives "NaN or infinity in data row r".
+    data row); ``label`` None gives "NaN or infinity in data row r". Time steps must be
+    positive, finite and at least :data:`MIN_PERIOD`.
     """
     for label, arrays in groups:
         bad = np.zeros(t.shape[0], bool)
@@ -309,13 +416,45 @@ def check_rows(path: str | os.PathLike[str], t: NDArray[np.float64],
             bad |= ~np.isfinite(a) if a.ndim == 1 else ~np.all(np.isfinite(a), axis=1)
         if np.any(bad):
             where = "" if label is None else f" the {label} at"
-            raise ValueError(f"{path}: NaN or infinity in{where} data row "
+            raise InputError(f"{path}: NaN or infinity in{where} data row "
                              f"{int(np.argmax(bad)) + 1}")
-    fault = first_bad_step(np.diff(t))
+    check_steps(path, np.diff(t), t)
+
+
+def check_steps(path: str | os.PathLike[str], d: NDArray[np.float64], t: NDArray[np.float64],
+                first_row: int = 1) -> None:
+    """Raise on the first time step ``d = diff(t)`` that is not positive, overflows or is
+    shorter than :data:`MIN_PERIOD`; ``first_row`` is the data row of ``t[0]``."""
+    fault = first_bad_step(d)
     if fault is not None:
         i, what = fault
-        raise ValueError(f"{path}: {what} time stamp in data row {i + 2} (t = {t[i + 1]!r} "
-                         f"after {t[i]!r})")
+        raise InputError(f"{path}: {what} time stamp in data row {i + first_row + 1} (t = "
+                         f"{t[i + 1]!r} after {t[i]!r})")
+    bad = ~np.isfinite(d) | (d < MIN_PERIOD)
+    if np.any(bad):
+        i = int(np.argmax(bad))
+        raise InputError(f"{path}: time step of {d[i]!r} s before data row {i + first_row + 1}; "
+                         f"steps must be finite and at least {MIN_PERIOD:g} s (check the time "
+                         "unit)")
+
+
+def check_motion(path: str | os.PathLike[str], values: NDArray[np.float64], kind: InputKind,
+                 h: float, first_row: int = 1) -> None:
+    """Raise when a sample turns the body by more than :data:`MAX_SAMPLE_ANGLE` (rates in
+    rad/s times the period ``h``, or increments in rad): such a log cannot be integrated
+    (the units or the sample rate are wrong)."""
+    if not MIN_PERIOD <= h <= MAX_PERIOD:
+        raise InputError(f"{path}: a sample period of {h!r} s; it must lie between "
+                         f"{MIN_PERIOD:g} and {MAX_PERIOD:g} s (check the time unit)")
+    if values.shape[0] == 0:
+        return
+    v = np.abs(values) * (h if kind == "rate" else 1.0)
+    angle = np.hypot(np.hypot(v[:, 0], v[:, 1]), v[:, 2])  # no overflow before the limit
+    bad = ~(angle <= MAX_SAMPLE_ANGLE)
+    if np.any(bad):
+        i = int(np.argmax(bad))
+        raise InputError(f"{path}: data row {i + first_row} turns the body by {angle[i]:.4g} rad "
+                         f"in one sample (at most π); check the units and the sample rate")
 
 
 def warn_implausible_rate(path: str | os.PathLike[str], rate: NDArray[np.float64], declared: str,
@@ -324,14 +463,16 @@ def warn_implausible_rate(path: str | os.PathLike[str], rate: NDArray[np.float64
     :data:`RATE_PLAUSIBLE_MAX` rad/s declared in radians is more likely degrees, one below
     1e-3 °/s declared in degrees more likely radians.
 
-    ``action="warn"`` issues a :class:`UnitWarning`; ``"error"`` raises ValueError saying
-    how to accept the units (``--accept-unit-warning``).
+    ``action="warn"`` issues a :class:`UnitWarning`; ``"error"`` raises an
+    :class:`~strapdown.InputError` saying how to accept the units (``--accept-unit-warning``).
     """
     if action not in UNIT_ACTIONS:
-        raise ValueError(f"action must be one of {', '.join(UNIT_ACTIONS)}, got {action!r}")
+        raise InputError(f"action must be one of {', '.join(UNIT_ACTIONS)}, got "
+                         f"{shown(action, 20)}")
     if rate.shape[0] == 0:
         return
-    big = float(np.percentile(np.linalg.norm(rate, axis=1), 99))
+    with np.errstate(over="ignore", invalid="ignore"):
+        big = float(np.percentile(np.linalg.norm(rate, axis=1), 99))
     msg = None
     if not declared.startswith("deg") and big > RATE_PLAUSIBLE_MAX:
         msg = (f"{path}: 99th-percentile rate {big:.0f} rad/s is implausible; the log is "
@@ -342,7 +483,7 @@ def warn_implausible_rate(path: str | os.PathLike[str], rate: NDArray[np.float64
     if msg is None:
         return
     if action == "error":
-        raise ValueError(f"{msg}; nothing computed. If the declared units are right, pass "
+        raise InputError(f"{msg}; nothing computed. If the declared units are right, pass "
                          "--accept-unit-warning")
     warnings.warn(msg, UnitWarning, stacklevel=3)
 
@@ -360,80 +501,98 @@ class _Source:
     what: str = ""  # the format, for messages
 
 
+def file_rate(path: str | os.PathLike[str], value: ArrayLike | None) -> float | None:
+    """A sampling rate a file states (one positive finite number, any shape of one
+    element), or None when it states none."""
+    if value is None:
+        return None
+    a = np.asarray(value)
+    if a.size != 1 or a.dtype.kind not in "biuf":
+        raise InputError(f"{path}: sampling_rate must be one number, got {a.dtype.name} of "
+                         f"shape {a.shape}")
+    fs = float(a.reshape(()))
+    if not (math.isfinite(fs) and fs > 0):
+        raise InputError(f"{path}: sampling_rate must be positive and finite, got {fs!r}")
+    return fs
+
+
 def _broad_source(path: Path, g, fs, sample_rate_hz) -> _Source:
     """BROAD's ``imu_gyr`` (rad/s) at its ``sampling_rate`` (or the one given)."""
     if fs is not None and sample_rate_hz is not None and not math.isclose(
             fs, sample_rate_hz, rel_tol=1e-9):
-        raise ValueError(f"{path}: the file states a sampling rate of {fs:g} Hz, not the "
+        raise InputError(f"{path}: the file states a sampling rate of {fs:g} Hz, not the "
                          f"{sample_rate_hz:g} Hz given")
     fs = fs if fs is not None else sample_rate_hz
     if not fs:
-        raise ValueError(f"{path}: no sampling_rate; pass --sample-rate-hz")
+        raise InputError(f"{path}: no sampling_rate; pass --sample-rate-hz")
     return _Source(np.arange(g.shape[0]) / fs, g, "rad/s", "the file's",
                    " (BROAD stores imu_gyr in rad/s)", "rate", "BROAD's imu_gyr")
 
 
 def _load_hdf5(path: Path, sample_rate_hz) -> _Source:
-    try:
-        import h5py
-    except ImportError:
-        raise ValueError(f"{path}: reading HDF5 needs h5py: pip install 'strapdown[hdf5]'"
-                         ) from None
-    with h5py.File(path, "r") as f:
-        if "gyro" in f and "t" in f:
-            return _Source(np.asarray(f["t"], float), np.asarray(f["gyro"], float))
-        if "imu_gyr" in f:
-            g = np.asarray(f["imu_gyr"], float)
-            fs = f.attrs.get("sampling_rate", None)
-            if fs is None and "sampling_rate" in f:
-                fs = np.asarray(f["sampling_rate"])
-            return _broad_source(path, g, None if fs is None else float(np.squeeze(fs)),
-                                 sample_rate_hz)
-        raise ValueError(f"{path}: HDF5 logs need datasets 't' and 'gyro' (or BROAD's "
-                         f"'imu_gyr'); found {sorted(f.keys())}")
+    c = read_hdf5(path, ["t", "gyro", "imu_gyr", "sampling_rate"], ["sampling_rate"])
+    a = c.arrays
+    if "gyro" in a and "t" in a:
+        return _Source(a["t"], a["gyro"])
+    if "imu_gyr" in a:
+        fs = c.attrs.get("sampling_rate", a.get("sampling_rate"))
+        return _broad_source(path, a["imu_gyr"], file_rate(path, fs), sample_rate_hz)
+    raise InputError(f"{path}: HDF5 logs need datasets 't' and 'gyro' (or BROAD's 'imu_gyr'); "
+                     f"found {c.found()}")
 
 
 def _load_mat(path: Path, sample_rate_hz) -> _Source:
-    from scipy.io import loadmat
-
-    m = loadmat(path)
+    c = read_mat(path, ["imu_gyr", "sampling_rate", *PSINS_VARIABLES])
+    m = c.arrays
     if "imu_gyr" in m:  # BROAD
-        fs = float(np.squeeze(m["sampling_rate"])) if "sampling_rate" in m else None
-        return _broad_source(path, np.asarray(m["imu_gyr"], float), fs, sample_rate_hz)
-    for key in ("avp_imu", "imu", "wvt"):  # PSINS-style [wm vm t]
+        return _broad_source(path, m["imu_gyr"], file_rate(path, m.get("sampling_rate")),
+                             sample_rate_hz)
+    for key in PSINS_VARIABLES:  # PSINS-style [wm vm t]
         if key in m:
-            a = np.asarray(m[key], float)
+            a = m[key]
             if a.ndim != 2 or a.shape[1] < 7:
-                raise ValueError(f"{path}: '{key}' must be [wm vm t] with ≥ 7 columns")
+                raise InputError(f"{path}: '{key}' must be [wm vm t] with ≥ 7 columns, got "
+                                 f"shape {a.shape}")
             return _Source(a[:, -1], a[:, 0:3], kind="increment",
                            what=f"PSINS-style '{key}' [wm vm t]")
-    keys = [k for k in m if not k.startswith("__")]
-    raise ValueError(f"{path}: no 'imu_gyr' (BROAD) or 'imu' [wm vm t] (PSINS) variable; "
-                     f"found {keys}")
+    raise InputError(f"{path}: no 'imu_gyr' (BROAD) or 'imu' [wm vm t] (PSINS) variable; "
+                     f"found {c.found()}")
 
 
-def _load(path: Path, columns, sample_rate_hz) -> _Source:
+#: MATLAB variables read as PSINS ``[wm vm t]`` logs, in order of preference.
+PSINS_VARIABLES = ("avp_imu", "imu", "wvt")
+
+
+def npy_log(path: str | os.PathLike[str]) -> NDArray[Any]:
+    """An ``(n, 4)`` ``[t, gx, gy, gz]`` ``.npy`` log, memory-mapped (any real dtype)."""
+    arr = open_npy(path)
+    if arr.ndim != 2 or arr.shape[1] != 4:
+        raise InputError(f"{path}: .npy logs must be (n, 4) [t, gx, gy, gz], got shape "
+                         f"{arr.shape}")
+    return arr
+
+
+def _load(path: Path, columns, sample_rate_hz, delimiter) -> _Source:
     """Stamps, gyro values and what the file says of itself, from any supported file."""
     suffix = path.suffix.lower()
-    if suffix == ".csv":
-        t, g, units = _load_csv(path, columns)
+    if suffix in (".csv", ".txt", ".tsv"):
+        t, g, units = _load_csv(path, columns, delimiter)
         return _Source(t, g, units)
     if suffix in (".h5", ".hdf5"):
         return _load_hdf5(path, sample_rate_hz)
     if suffix == ".npy":
-        arr = np.load(path, mmap_mode="r")
-        if arr.ndim != 2 or arr.shape[1] != 4:
-            raise ValueError(f"{path}: .npy logs must be (n, 4) [t, gx, gy, gz], got {arr.shape}")
+        arr = npy_log(path)
+        check_bytes(path, arr.shape[0] * 32, "the log as float64")
         return _Source(np.asarray(arr[:, 0], float), np.asarray(arr[:, 1:], float))
     if suffix == ".npz":
-        with np.load(path) as z:
-            if "gyro" not in z or "t" not in z:
-                raise ValueError(f"{path}: .npz logs need arrays 't' and 'gyro'")
-            return _Source(np.asarray(z["t"], float), np.asarray(z["gyro"], float))
+        z = read_npz(path, ["t", "gyro"])
+        if "gyro" not in z.arrays or "t" not in z.arrays:
+            raise InputError(f"{path}: .npz logs need arrays 't' and 'gyro'; found {z.found()}")
+        return _Source(z.arrays["t"].astype(float), z.arrays["gyro"].astype(float))
     if suffix == ".mat":
         return _load_mat(path, sample_rate_hz)
-    raise ValueError(f"{path}: unsupported format {suffix!r} (use .csv, .npy, .npz, .h5 or "
-                     ".mat)")
+    raise InputError(f"{path}: unsupported format {shown(suffix, 20)} (use .csv, .npy, .npz, "
+                     ".h5 or .mat)")
 
 
 def _declared_units(path: Path, src: _Source, kind: InputKind, units: str | None) -> str:
@@ -442,27 +601,71 @@ def _declared_units(path: Path, src: _Source, kind: InputKind, units: str | None
     allowed: tuple[GyroUnit, ...] = RATE_UNITS if kind == "rate" else INCREMENT_UNITS
     if src.kind is not None and src.kind != kind:
         holds = "rates" if src.kind == "rate" else "increments"
-        raise ValueError(f"{path}: {src.what} holds {holds}; pass "
+        raise InputError(f"{path}: {src.what} holds {holds}; pass "
                          f"--{'rates' if src.kind == 'rate' else 'increments'}")
     if src.units is not None:
         if src.units not in allowed:
-            raise ValueError(f"{path}: the header declares {src.units!r}; a {kind} log "
+            raise InputError(f"{path}: the header declares {shown(src.units, 30)}; a {kind} log "
                              f"needs one of {allowed}")
         if units is not None and units != src.units:
-            raise ValueError(f"{path}: declared units {units!r} contradict {src.whose} "
+            raise InputError(f"{path}: declared units {units!r} contradict {src.whose} "
                              f"{src.units!r}{src.note}")
         return src.units
     if units is None:
-        raise ValueError(f"{path}: no units declared; pass --units or write them in the header "
+        raise InputError(f"{path}: no units declared; pass --units or write them in the header "
                          f"(e.g. gx[{allowed[0]}])")
     return units
+
+
+def check_read_options(*, kind: object, units: object, gap_tolerance: object, on_gap: object,
+                       saturation: object, sample_rate_hz: object,
+                       columns: Sequence[str] | None = None) -> None:
+    """The reading options every input route shares (:func:`read_imu`, the streamed
+    ``.npy`` path of ``strapdown run``), checked before any file is opened."""
+    if kind not in INPUT_KINDS:
+        raise InputError(f"kind must be 'rate' or 'increment', got {shown(kind, 20)}")
+    allowed: tuple[GyroUnit, ...] = RATE_UNITS if kind == "rate" else INCREMENT_UNITS
+    if units is not None and units not in allowed:
+        raise InputError(f"{kind} units must be one of {allowed}, got {shown(units, 20)}")
+    if on_gap not in GAP_POLICIES:
+        raise InputError(f"on_gap must be 'report' or 'error', got {shown(on_gap, 20)}")
+    if not 1 < _as_float(gap_tolerance) < math.inf:
+        raise InputError(f"gap_tolerance is in sample intervals and must be finite and exceed "
+                         f"1, got {shown(gap_tolerance, 20)}")
+    if saturation is not None and not 0 < _as_float(saturation) < math.inf:
+        raise InputError(f"saturation must be positive and finite, got {shown(saturation, 20)}")
+    if sample_rate_hz is not None and not (1 / MAX_PERIOD <= _as_float(sample_rate_hz)
+                                           <= 1 / MIN_PERIOD):
+        raise InputError(f"the sample rate must be positive and finite, between "
+                         f"{1 / MAX_PERIOD:g} and {1 / MIN_PERIOD:g} Hz, got "
+                         f"{shown(sample_rate_hz, 20)}")
+    if columns is not None and len(columns) != 4:
+        raise InputError(f"columns must name time and three axes, got {shown(columns, 80)}")
+
+
+def _as_float(x: object) -> float:
+    """``x`` as a float when it is a real number (not a bool), else NaN (fails every bound)."""
+    if isinstance(x, (int, float, np.integer, np.floating)) and not isinstance(x, bool):
+        return float(x)
+    return math.nan
+
+
+def input_file(path: str | os.PathLike[str], what: str = "file") -> Path:
+    """``path`` as a Path, an :class:`~strapdown.InputError` unless it is an existing
+    regular file (a directory or a missing file is the user's mistake)."""
+    path = Path(path)
+    if path.is_dir():
+        raise InputError(f"{path}: is a directory; expected a {what}")
+    if not path.is_file():
+        raise InputError(f"{path}: no such {what}")
+    return path
 
 
 def read_imu(path: str | os.PathLike[str], *, kind: InputKind, units: GyroUnit | None,
              columns: Sequence[str] | None = None,
              sample_rate_hz: float | None = None, gap_tolerance: float = 1.5,
              on_gap: GapPolicy = "report", saturation: float | None = None,
-             unit_check: UnitAction = "warn") -> ImuLog:
+             unit_check: UnitAction = "warn", delimiter: str | None = None) -> ImuLog:
     """Read and validate a gyro log (see the module docstring).
 
     Parameters
@@ -489,34 +692,28 @@ def read_imu(path: str | os.PathLike[str], *, kind: InputKind, units: GyroUnit |
         or above it are listed in :attr:`ImuLog.saturated`.
     unit_check : {"warn", "error"}
         What magnitudes that suggest the other unit do (:func:`warn_implausible_rate`).
+    delimiter : str, optional
+        A CSV's delimiter (:data:`DELIMITERS`); default: detected from the header row.
+
+    Raises
+    ------
+    InputError
+        For anything wrong with the file or the options, naming the file and what was
+        expected (:mod:`strapdown.io.containers` for the binary formats). A sample turning
+        the body by more than π (:func:`check_motion`) or time steps under
+        :data:`MIN_PERIOD` are errors too.
     """
-    path = Path(path)
-    if kind not in INPUT_KINDS:
-        raise ValueError(f"kind must be 'rate' or 'increment', got {kind!r}")
-    allowed: tuple[GyroUnit, ...] = RATE_UNITS if kind == "rate" else INCREMENT_UNITS
-    if units is not None and units not in allowed:
-        raise ValueError(f"{kind} units must be one of {allowed}, got {units!r}")
-    if on_gap not in GAP_POLICIES:
-        raise ValueError(f"on_gap must be 'report' or 'error', got {on_gap!r}")
-    if not gap_tolerance > 1:
-        raise ValueError(f"gap_tolerance is in sample intervals and must exceed 1, got "
-                         f"{gap_tolerance}")
-    if saturation is not None and not saturation > 0:
-        raise ValueError(f"saturation must be positive, got {saturation}")
-    if sample_rate_hz is not None and not (sample_rate_hz > 0 and math.isfinite(sample_rate_hz)):
-        raise ValueError(f"the sample rate must be positive and finite, got {sample_rate_hz}")
-    if columns is not None and len(columns) != 4:
-        raise ValueError(f"columns must name time and three axes, got {columns}")
-    if not path.is_file():
-        raise ValueError(f"{path}: no such file")
-    src = _load(path, None if columns is None else list(columns), sample_rate_hz)
+    check_read_options(kind=kind, units=units, gap_tolerance=gap_tolerance, on_gap=on_gap,
+                       saturation=saturation, sample_rate_hz=sample_rate_hz, columns=columns)
+    path = input_file(path, "log file")
+    src = _load(path, None if columns is None else list(columns), sample_rate_hz, delimiter)
     unit = _declared_units(path, src, kind, units)
     t, g = src.t, src.gyro
-    if g.ndim != 2 or g.shape[1] != 3 or t.shape[0] != g.shape[0]:
-        raise ValueError(f"{path}: expected n times and (n, 3) gyro values, got {t.shape}, "
-                         f"{g.shape}")
+    if t.ndim != 1 or g.ndim != 2 or g.shape[1] != 3 or t.shape[0] != g.shape[0]:
+        raise InputError(f"{path}: expected n times of shape (n,) and gyro values of shape "
+                         f"(n, 3), got {t.shape} and {g.shape}")
     if t.size < 2:
-        raise ValueError(f"{path}: {t.size} samples; at least 2 are needed")
+        raise InputError(f"{path}: {t.size} samples; at least 2 are needed")
     check_rows(path, t, [(None, [t, g])])
     d = np.diff(t)
     h = float(np.median(d))
@@ -526,7 +723,7 @@ def read_imu(path: str | os.PathLike[str], *, kind: InputKind, units: GyroUnit |
     gaps = [int(i) + 2 for i in np.flatnonzero(d > gap_tolerance * unit_h)]
     if gaps and on_gap == "error":
         r = gaps[0]
-        raise ValueError(f"{path}: gap of {d[r - 2]:.6g} s ({d[r - 2] / unit_h:.1f} sample "
+        raise InputError(f"{path}: gap of {d[r - 2]:.6g} s ({d[r - 2] / unit_h:.1f} sample "
                          f"intervals) before data row {r}")
     saturated = []
     if saturation is not None:
@@ -534,24 +731,34 @@ def read_imu(path: str | os.PathLike[str], *, kind: InputKind, units: GyroUnit |
     scale = _DEG if unit.startswith("deg") else 1.0
     g = g * scale
     warn_implausible_rate(path, g if kind == "rate" else g / h, unit, action=unit_check)
+    check_motion(path, g, kind, unit_h)
     return ImuLog(np.asarray(t, float), np.ascontiguousarray(g), kind, h, gaps, saturated,
                   unit, nominal)
 
 
 def write_attitude(path: str | os.PathLike[str], t: ArrayLike, q: NDArray[np.float64], *,
                    extra: Mapping[str, ArrayLike] | None = None) -> Path:
-    """Write ``t, qw, qx, qy, qz`` (+ extra columns) atomically as CSV or ``.npz``."""
+    """Write ``t, qw, qx, qy, qz`` (+ extra columns) atomically as CSV or ``.npz``.
+
+    A non-finite value anywhere is an :class:`~strapdown.InputError` and nothing is written.
+    """
     path = Path(path)
     # Any: np.savez's column keywords share its signature with allow_pickle: bool
     cols: dict[str, Any] = {"t": np.asarray(t), "qw": q[:, 0], "qx": q[:, 1], "qy": q[:, 2],
                             "qz": q[:, 3]}
     cols.update(extra or {})
+    for name, col in cols.items():
+        bad = ~np.isfinite(np.asarray(col, float))
+        if np.any(bad):
+            i = int(np.argmax(bad.reshape(bad.shape[0], -1).any(axis=1)))
+            raise InputError(f"{path}: {name} is NaN or infinite from output row {i + 1}; "
+                             "nothing written")
     if path.suffix.lower() == ".npz":
         with atomic_path(path) as tmp, open(tmp, "wb") as f:
             np.savez(f, **cols)
         return path
     if path.suffix.lower() != ".csv":
-        raise ValueError(f"{path}: output must be .csv or .npz")
+        raise InputError(f"{path}: output must be .csv or .npz")
     names = list(cols)
     table = np.column_stack([np.asarray(cols[k], float) for k in names])
     with atomic_path(path) as tmp:
