@@ -41,15 +41,18 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from tqdm import tqdm
 
+from strapdown._core.errors import InputError
 from strapdown._core.kinds import InputKind
 from strapdown.algorithms.navigation import NavStream
 from strapdown.algorithms.rate import JITTER_TOLERANCE
 from strapdown.algorithms.velocity import NavStructure
 from strapdown.io import read_imu
+from strapdown.io.containers import read_hdf5, read_mat, read_npz
 from strapdown.io.files import atomic_path
 from strapdown.io.readers import (
     ACC_COLUMNS,
     GYRO_COLUMNS,
+    PSINS_VARIABLES,
     GyroUnit,
     UnitAction,
     UnitWarning,
@@ -104,11 +107,11 @@ def _csv_accel(path: Path, columns: Sequence[str] | None) -> tuple[NDArray[np.fl
         acc = list(columns[4:7])
         missing = [c for c in acc if c not in names]
         if missing:
-            raise ValueError(f"{path}: no accelerometer columns {missing} in the header {names}")
+            raise InputError(f"{path}: no accelerometer columns {missing} in the header {names}")
     raw, units, _ = csv_columns(path, acc)
     found = {units[c] for c in acc if c in units}
     if len(found) > 1:
-        raise ValueError(f"{path}: the header gives the accelerometer axes different units "
+        raise InputError(f"{path}: the header gives the accelerometer axes different units "
                          f"{sorted(found)}")
     return raw, (found.pop() if found else None)
 
@@ -120,31 +123,27 @@ def _accel_source(path: Path, columns: Sequence[str] | None
     if suffix == ".csv":
         return _csv_accel(path, columns)
     if suffix == ".npz":
-        with np.load(path) as z:
-            if "accel" not in z:
-                raise ValueError(f"{path}: no accelerometer array 'accel' (found "
-                                 f"{sorted(z.keys())})")
-            return np.asarray(z["accel"], float), None
+        z = read_npz(path, ["accel"])
+        if "accel" not in z.arrays:
+            raise InputError(f"{path}: no accelerometer array 'accel' (found {z.found()})")
+        return z.arrays["accel"].astype(float), None
     if suffix in (".h5", ".hdf5"):
-        import h5py  # read_imu has already said how to install it when it is missing
-
-        with h5py.File(path, "r") as f:
-            for key, unit in (("accel", None), ("imu_acc", "m/s2")):
-                if key in f:
-                    return np.asarray(f[key], float), unit
-            raise ValueError(f"{path}: no accelerometer dataset 'accel' (or BROAD's 'imu_acc'); "
-                             f"found {sorted(f.keys())}")
+        c = read_hdf5(path, ["accel", "imu_acc"])
+        for key, unit in (("accel", None), ("imu_acc", "m/s2")):
+            if key in c.arrays:
+                return c.arrays[key], unit
+        raise InputError(f"{path}: no accelerometer dataset 'accel' (or BROAD's 'imu_acc'); "
+                         f"found {c.found()}")
     if suffix == ".mat":
-        from scipy.io import loadmat
-
-        m = loadmat(path)
-        if "imu_acc" in m:  # BROAD: m/s²
-            return np.asarray(m["imu_acc"], float), "m/s2"
-        for key in ("avp_imu", "imu", "wvt"):  # PSINS [wm vm t]: vm in m/s
-            if key in m:
-                return np.asarray(m[key], float)[:, 3:6], "m/s"
-        raise ValueError(f"{path}: no accelerometer ('imu_acc' or PSINS [wm vm t])")
-    raise ValueError(f"{path}: nav logs are .csv, .npz, .h5/.hdf5 or .mat, not {suffix!r}")
+        m = read_mat(path, ["imu_acc", *PSINS_VARIABLES])
+        if "imu_acc" in m.arrays:  # BROAD: m/s²
+            return m.arrays["imu_acc"], "m/s2"
+        for key in PSINS_VARIABLES:  # PSINS [wm vm t]: vm in m/s
+            if key in m.arrays:
+                return m.arrays[key][:, 3:6], "m/s"
+        raise InputError(f"{path}: no accelerometer ('imu_acc' or PSINS [wm vm t]); found "
+                         f"{m.found()}")
+    raise InputError(f"{path}: nav logs are .csv, .npz, .h5/.hdf5 or .mat, not {suffix!r}")
 
 
 def _acc_unit(path: Path, kind: InputKind, declared: str | None, stated: str | None) -> str:
@@ -152,17 +151,17 @@ def _acc_unit(path: Path, kind: InputKind, declared: str | None, stated: str | N
     if stated is not None:
         stated = canonical_unit(stated)
         if stated not in allowed:
-            raise ValueError(f"{path}: the accelerometer is in {stated!r}; a {kind} log needs "
+            raise InputError(f"{path}: the accelerometer is in {stated!r}; a {kind} log needs "
                              f"one of {allowed}")
         if declared is not None and declared != stated:
-            raise ValueError(f"{path}: declared accelerometer units {declared!r} contradict "
+            raise InputError(f"{path}: declared accelerometer units {declared!r} contradict "
                              f"the file's {stated!r}")
         return stated
     if declared is None:
-        raise ValueError(f"{path}: no accelerometer units declared; pass --acc-units or write "
+        raise InputError(f"{path}: no accelerometer units declared; pass --acc-units or write "
                          f"them in the header (e.g. ax[{'m/s^2' if kind == 'rate' else 'm/s'}])")
     if declared not in allowed:
-        raise ValueError(f"{path}: accelerometer units {declared!r} do not fit a {kind} log; "
+        raise InputError(f"{path}: accelerometer units {declared!r} do not fit a {kind} log; "
                          f"use one of {allowed}")
     return declared
 
@@ -181,7 +180,7 @@ def _check_acc_magnitude(path: Path, f: NDArray[np.float64], unit: str,
     if msg is None:
         return
     if action == "error":
-        raise ValueError(f"{msg}; nothing computed. If the declared units are right, pass "
+        raise InputError(f"{msg}; nothing computed. If the declared units are right, pass "
                          "--accept-unit-warning")
     warnings.warn(msg, UnitWarning, stacklevel=3)
 
@@ -195,7 +194,7 @@ def _uniform_period(path: Path, t: NDArray[np.float64], nominal: float | None) -
     resid -= resid.mean()
     worst = int(np.argmax(np.abs(resid)))
     if abs(resid[worst]) > JITTER_TOLERANCE * td:
-        raise ValueError(f"{path}: time stamps not uniform: data row {worst + 1} lies "
+        raise InputError(f"{path}: time stamps not uniform: data row {worst + 1} lies "
                          f"{abs(resid[worst]) / td:.3g} periods off the grid of period "
                          f"{td:.9g} s; navigation needs uniformly sampled logs")
     return td
@@ -220,19 +219,19 @@ def read_nav_log(path: str | os.PathLike[str], *, kind: InputKind = "rate",
     """
     path = Path(path)
     if columns is not None and len(columns) != 7:
-        raise ValueError(f"columns must name time, three gyro and three accelerometer axes, "
+        raise InputError(f"columns must name time, three gyro and three accelerometer axes, "
                          f"got {len(columns)}: {list(columns)}")
     if acc_units is not None and acc_units not in ACC_UNITS:
-        raise ValueError(f"accelerometer units must be one of {ACC_UNITS}, got {acc_units!r}")
+        raise InputError(f"accelerometer units must be one of {ACC_UNITS}, got {acc_units!r}")
     if path.suffix.lower() == ".npy":
-        raise ValueError(f"{path}: .npy logs hold a gyro only; a nav log is .csv, .npz, "
+        raise InputError(f"{path}: .npy logs hold a gyro only; a nav log is .csv, .npz, "
                          ".h5/.hdf5 or .mat")
     log = read_imu(path, kind=kind, units=units,
                    columns=None if columns is None else list(columns[:4]),
                    sample_rate_hz=sample_rate_hz, on_gap="error", unit_check=unit_check)
     acc, stated = _accel_source(path, columns)
     if acc.ndim != 2 or acc.shape != log.data.shape:
-        raise ValueError(f"{path}: {log.data.shape[0]} gyro samples but accelerometer values of "
+        raise InputError(f"{path}: {log.data.shape[0]} gyro samples but accelerometer values of "
                          f"shape {acc.shape}")
     check_rows(path, log.t, [("accelerometer", [acc])])
     unit = _acc_unit(path, kind, acc_units, stated)
@@ -253,7 +252,7 @@ def increments_from_rates(w: ArrayLike, h: float) -> NDArray[np.float64]:
     w = np.asarray(w, dtype=np.float64)
     n = w.shape[0]
     if n < 2:
-        raise ValueError(f"rates give increments between samples: need at least 2, got {n}")
+        raise InputError(f"rates give increments between samples: need at least 2, got {n}")
     if n == 2:
         return 0.5 * h * (w[:1] + w[1:])
     out = np.empty((n - 1, 3))
@@ -270,16 +269,16 @@ def _initial_state(lat_deg: float, lon_deg: float, height: float,
     """(lat, lon rad, height, v NED, q_n_b) from the command line's initial state."""
     for name, c in (("latitude", lat_deg), ("longitude", lon_deg), ("height", height)):
         if not math.isfinite(c):
-            raise ValueError(f"initial {name} must be finite, got {c}")
+            raise InputError(f"initial {name} must be finite, got {c}")
     if not abs(lat_deg) < 90.0:
-        raise ValueError(f"initial latitude must lie within ±90°, got {lat_deg}°")
+        raise InputError(f"initial latitude must lie within ±90°, got {lat_deg}°")
     v = np.zeros(3) if velocity is None else np.asarray(velocity, dtype=np.float64)
     ypr = np.zeros(3) if attitude_deg is None else np.asarray(attitude_deg, dtype=np.float64)
     for name, x in (("velocity (VN VE VD)", v), ("attitude (YAW PITCH ROLL)", ypr)):
         if x.shape != (3,):
-            raise ValueError(f"initial {name} needs three values, got {x.size}")
+            raise InputError(f"initial {name} needs three values, got {x.size}")
         if not np.all(np.isfinite(x)):
-            raise ValueError(f"initial {name} must be finite, got {x.tolist()}")
+            raise InputError(f"initial {name} must be finite, got {x.tolist()}")
     q = quat_from_dcm(dcm_from_euler_zyx(*np.radians(ypr)))
     return math.radians(lat_deg), math.radians(lon_deg), float(height), v, q
 
@@ -291,9 +290,9 @@ def _rows(sol) -> NDArray[np.float64]:
 
 def _check_out(imu: Path, out: Path) -> None:
     if out.resolve() == imu.resolve():
-        raise ValueError("--out must not be the input file")
+        raise InputError("--out must not be the input file")
     if out.suffix.lower() not in (".csv", ".npz"):
-        raise ValueError(f"{out}: output must be .csv or .npz")
+        raise InputError(f"{out}: output must be .csv or .npz")
 
 
 def navigate_log(imu: str | os.PathLike[str], out: str | os.PathLike[str], *, lat_deg: float,
@@ -358,7 +357,7 @@ def _stream_to(out: Path, stream: NavStream, g: NDArray[np.float64], a: NDArray[
             rows = _rows(sol)
             if not np.all(np.isfinite(rows)):
                 i = int(np.argmax(~np.all(np.isfinite(rows), axis=1)))
-                raise ValueError(f"the navigation diverged (NaN or infinity) at t = "
+                raise InputError(f"the navigation diverged (NaN or infinity) at t = "
                                  f"{rows[i, 0]:.6g} s; nothing written")
             n_out += rows.shape[0]
             if csv_out:
@@ -366,7 +365,7 @@ def _stream_to(out: Path, stream: NavStream, g: NDArray[np.float64], a: NDArray[
             else:
                 parts.append(rows)
         if n_out == 0:
-            raise ValueError(f"{stream.n} subsamples per update need at least {stream.n} "
+            raise InputError(f"{stream.n} subsamples per update need at least {stream.n} "
                              f"intervals, the log has {g.shape[0]}; nothing written")
         if not csv_out:
             f.close()
