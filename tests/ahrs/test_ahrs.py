@@ -41,7 +41,8 @@ def _plain_python(monkeypatch):
     from numba.core.registry import CPUDispatcher
 
     compiled = {n: f for n, f in vars(K).items() if isinstance(f, CPUDispatcher)}
-    assert {"ekf_kernel", "_joseph", "_window_step", "_reset", "_update"} <= set(compiled)
+    assert {"ekf_kernel", "_gated_update", "_consider_update", "_window_step", "_reset",
+            "_update", "_lowpass", "_mag_disturbance"} <= set(compiled)
     for name, f in compiled.items():
         monkeypatch.setattr(K, name, f.py_func)
 

@@ -10,43 +10,51 @@ a small function that numba inlines into the loop (``inline="always"``):
    increment forms, conventional or sliding), :func:`_startup_step` (the
    sliding scheme's first outputs) or :func:`_rk4_step` (quaternion RK4);
 2. :func:`_fold_rest_samples` — the rest detector's moving averages;
-3. :func:`_process_noise` and :func:`_propagate_covariance` — ``P ← Φ P Φᵀ + Q``;
+3. :func:`_propagate_covariance` and :func:`_add_process_noise` — ``P ← Φ P Φᵀ + Q``,
+   with a tilt noise proportional to the rotation rate;
 4. :func:`_rest_detect` and :func:`_rest_model` — the zero-rate bias update;
 5. the accelerometer: recovery (:func:`_acc_recovery`), then the model of
-   ``AhrsConfig.acc_model`` — :func:`_acc_lowpass_model` (Laidig & Seel
-   (2023) — VQF's idea) or :func:`_acc_plausible`, :func:`_lever_sigma` and
-   :func:`_acc_raw_model` (the Singer (1970) manoeuvre state);
-6. the magnetometer as a heading measurement: :func:`_mag_plausible`, the
-   settling time, recovery (:func:`_mag_recovery`), :func:`_heading_model`;
-7. :func:`_reset` — error-state injection into the attitude, the biases and the
-   sliding scheme's bases (and :func:`_rotate_small` for the averaged specific force);
-8. the record: one row of :class:`Outputs`.
+   ``AhrsConfig.acc_model`` — :func:`_acc_lowpass_model` (Laidig & Seel (2023),
+   VQF's idea: the specific force in the almost-inertial reference frame through a
+   second-order Butterworth low-pass, :func:`_lowpass`) or :func:`_acc_plausible`,
+   :func:`_lever_sigma` and :func:`_acc_raw_model` (the Singer (1970) manoeuvre state);
+6. the magnetometer as a heading measurement: the field rotated into the reference
+   frame with the attitude of ``mag_delay`` epochs earlier (:func:`_delayed_field`),
+   its norm and dip low-passed and compared with a slowly learned reference
+   (:func:`_mag_disturbance`, after Laidig & Seel (2023), Sec. 2.5), recovery
+   (:func:`_mag_recovery`), :func:`_heading_model` and the heading update
+   :func:`_consider_update`, whose innovation variance includes the tilt error
+   (through the field's dip) but whose gain never reaches roll and pitch;
+7. :func:`_reset` — error-state injection into the attitude, the biases, the
+   sliding scheme's bases and the low-pass states (:func:`_rotate_small`);
+8. the record: the epoch's sample's row of :class:`Outputs`.
 
 A measurement model fills H, R and the innovation y; the loop applies it with
-the gated Joseph-form update :func:`_joseph`. The public wrapper
-(:func:`strapdown.ahrs.filter.ekf`) validates everything; the kernel trusts it.
+the gated sequential update :func:`_gated_update` (or :func:`_consider_update`). The public
+wrapper (:func:`strapdown.ahrs.filter.ekf`) validates everything; the kernel trusts it.
 Its arguments are typed records (:class:`Sensors`, :class:`Propagation`,
 :class:`Window`, :class:`Params`, :class:`Initial`, :class:`Outputs`),
 NamedTuples that numba passes as structs. It is tested against its own
 plain-Python execution and, for accuracy, against exact simulated truth.
 
-Written for speed (the loop allocates nothing per epoch and runs as fast as the
-single-function kernel it replaced): numba keeps a reference count per array
-bound to an inlined function's argument and removes that count only when
-nothing in between can release a reference. So the stages take their arrays one
+Written for speed (the loop allocates nothing per epoch): numba keeps a reference
+count per array bound to an inlined function's argument and removes that count only
+when nothing in between can release a reference. So the stages take their arrays one
 by one (never a record holding arrays: records that reach a stage hold scalars
 only), every array's last use in a stage is unconditional, a stage allocates
-nothing and creates no views, and calls to the non-inlined :func:`_joseph` and
-the divisions that may raise (Python's ``ZeroDivisionError``) stay out of the
-stages where they can.
+nothing and creates no views. Compiled with numba's ``error_model="numpy"``: a
+division by zero gives inf or NaN instead of raising (a raise would also keep the
+counts), and the wrapper's inputs never lead to one.
 
 Measurement noises are densities: an update every ``T`` seconds uses
 ``R = density² / T``, so the filter's bandwidth does not depend on the
 propagation algorithm's update period.
 
 Frames: ENU reference; ``q`` is q_n_b (Hamilton, scalar first). Error state
-``x = [δθ_b, δb_g, a_b]`` (``+ δb_a``, the accelerometer bias, when ``P0`` is
-12 × 12) with ``q_true = q̂ ⊗ q(δθ_b)``.
+``x = [δθ_b, δb_g]``, then the Singer manoeuvre acceleration ``a_b`` with the raw
+accelerometer model, then the accelerometer bias ``δb_a`` when estimated (6, 9 or 12
+states; ``P0``'s size and ``Params.acc_lowpass`` say which), with
+``q_true = q̂ ⊗ q(δθ_b)``.
 """
 
 from __future__ import annotations
@@ -69,6 +77,11 @@ F_REST = int(MeasurementFlag.REST)
 F_ACC_RECOVERED = int(MeasurementFlag.ACC_RECOVERED)
 F_MAG_RECOVERED = int(MeasurementFlag.MAG_RECOVERED)
 F_ACC_DISTURBED = int(MeasurementFlag.ACC_DISTURBED)
+
+# the magnetometer's disturbance state (a float array the stages share, see
+# _mag_disturbance): reference norm and dip, time undisturbed, disturbed (0/1), candidate
+# norm, dip and time, time rejected
+M_NORM, M_DIP, M_UNDIST, M_DIST, M_CNORM, M_CDIP, M_CT, M_REJECT = range(8)
 
 
 class Sensors(NamedTuple):
@@ -110,10 +123,12 @@ class Window(NamedTuple):
 
 class Params(NamedTuple):
     """Tuning (the fields of :class:`strapdown.ahrs.AhrsConfig` the loop reads, same
-    names and units), the reference field and the switches."""
+    names and units), the reference field, the switches, and coefficients derived for
+    the epoch period (the low-passes, the delay in epochs)."""
 
     gyro_noise: float
     gyro_bias_rw: float
+    tilt_rate_noise: float
     singer_sigma: float
     singer_tau: float
     acc_noise: float
@@ -142,14 +157,31 @@ class Params(NamedTuple):
     soft_gate: bool  #: acc_gate_mode == "soft"
     lever_arm: float
     acc_lowpass: bool  #: acc_model == "lowpass" (else "raw")
-    acc_lowpass_s: float
     acc_lowpass_noise: float
     acc_gate_lowpass: float
     acc_bias_rw: float
+    mag_new_s: float
+    mag_new_min_rate: float
+    mag_reject_s: float
+    mag_disturbed_factor: float
+    lp_b0: float  #: the accelerometer low-pass (second-order Butterworth at the epoch
+    lp_b1: float  #: period): numerator,
+    lp_b2: float
+    lp_a1: float  #: denominator (a0 = 1),
+    lp_a2: float
+    lp_init_n: int  #: epochs averaged before the filter starts
+    mc_b0: float  #: the low-pass of the field's norm and dip, likewise
+    mc_b1: float
+    mc_b2: float
+    mc_a1: float
+    mc_a2: float
+    mc_init_n: int
+    mag_ref_k: float  #: gain of the reference's slow update per epoch
+    mag_delay: int  #: the magnetometer's delay, epochs
 
 
 class Initial(NamedTuple):
-    """Initial q_n_b (4,), gyro bias (3,) and error covariance (9 × 9 or 12 × 12)."""
+    """Initial q_n_b (4,), gyro bias (3,) and error covariance (6, 9 or 12 square)."""
 
     q: np.ndarray
     gyro_bias: np.ndarray
@@ -157,10 +189,12 @@ class Initial(NamedTuple):
 
 
 class Outputs(NamedTuple):
-    """Output rows, one per epoch (allocated by the caller, at least as many as epochs):
-    q (m, 4), gyro_bias, accel, acc_bias (m, 3), sample (the epoch's sample index), flags
-    (m,) int64, nis (m, 2) (accelerometer, heading; NaN without an update), attitude_sigma
-    (m, 3)."""
+    """The outputs, allocated by the caller with a row per sample (n): each epoch writes
+    the row of its sample k — q (n, 4), gyro_bias, accel, acc_bias (n, 3), flags (n,)
+    int64, nis (n, 2) (accelerometer, heading; NaN without an update), attitude_sigma
+    (n, 3), attitude_cov (n, 3, 3) (of δθ_b), bias_var (n, 3) (the gyro bias's
+    variances) — and ``sample[e]``, epoch e's sample index; other rows are left as
+    they were."""
 
     q: np.ndarray
     gyro_bias: np.ndarray
@@ -170,13 +204,15 @@ class Outputs(NamedTuple):
     flags: np.ndarray
     nis: np.ndarray
     attitude_sigma: np.ndarray
+    attitude_cov: np.ndarray
+    bias_var: np.ndarray
 
 
 # ---------------------------------------------------------------- small numerics
 # (Work arrays come from the caller: the loop allocates nothing per epoch.)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _dcm(q, c):
     """C_n_b of q (3, 3) into c."""
     w, x, y, z = q[0], q[1], q[2], q[3]
@@ -191,16 +227,20 @@ def _dcm(q, c):
     c[2, 2] = 1.0 - 2.0 * (x * x + y * y)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _small_rotation(eps):
-    """(scalar part, vector-part factor) of q(ε) = [cos(|ε|/2), sin(|ε|/2) ε/|ε|]."""
-    ang = np.sqrt(eps[0] * eps[0] + eps[1] * eps[1] + eps[2] * eps[2])
-    if ang < 1e-8:
-        return 1.0 - ang * ang / 8.0, 0.5 - ang * ang / 48.0
+    """(scalar part, vector-part factor) of q(ε) = [cos(|ε|/2), sin(|ε|/2) ε/|ε|]; below
+    |ε| = 0.01 rad (every correction of a filter that is not diverging) by their Taylor
+    series to |ε|⁶, whose first omitted terms are below 1e-23."""
+    a2 = eps[0] * eps[0] + eps[1] * eps[1] + eps[2] * eps[2]
+    if a2 < 1e-4:
+        return (1.0 - a2 / 8.0 * (1.0 - a2 / 48.0 * (1.0 - a2 / 120.0)),
+                0.5 - a2 / 48.0 * (1.0 - a2 / 80.0 * (1.0 - a2 / 168.0)))
+    ang = np.sqrt(a2)
     return np.cos(0.5 * ang), np.sin(0.5 * ang) / ang
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _left_rotated(eps, w0, x0, y0, z0):
     """q(ε) ⊗ (w0, x0, y0, z0), normalised (a small reference-frame rotation)."""
     dw, s = _small_rotation(eps)
@@ -213,7 +253,7 @@ def _left_rotated(eps, w0, x0, y0, z0):
     return w / nrm, x / nrm, y / nrm, z / nrm
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _rotate_small(eps, v):
     """v ← (I + [ε×]) v: a vector in the reference frame follows a small rotation ε."""
     l0 = v[0] + eps[1] * v[2] - eps[2] * v[1]
@@ -224,7 +264,7 @@ def _rotate_small(eps, v):
     v[2] = l2
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _window_phi(x, b, offsets, weights, pi, pj, pc, sa, sb, bias_x, phi, nodes):
     """φ of the windowed form over samples starting at b, bias removed from every node
     (``nodes``: a work array with a row per node)."""
@@ -247,7 +287,7 @@ def _window_phi(x, b, offsets, weights, pi, pj, pc, sa, sb, bias_x, phi, nodes):
         phi[2] += c * (nodes[i, 0] * nodes[j, 1] - nodes[i, 1] * nodes[j, 0])
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _rk4(q, w, h2, out, k, y):
     """One quaternion RK4 step of length h2 with rates w[0], w[1], w[2] at start, middle,
     end (work arrays k (4, 4), y (4,))."""
@@ -275,7 +315,7 @@ def _rk4(q, w, h2, out, k, y):
         out[i] /= nrm
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _inverse_sym(S, m, out):
     """Inverse of a symmetric m × m matrix, m ≤ 3 (explicit cofactors)."""
     if m == 1:
@@ -305,108 +345,78 @@ def _inverse_sym(S, m, out):
         out[2, 2] = (a * e - b * d) / det
 
 
-@njit(cache=True, inline="always")
-def _mul_bt(X, H, out):
-    """out = X Hᵀ (X: n × k, H: m × k)."""
-    for i in range(X.shape[0]):
-        for j in range(H.shape[0]):
-            acc = 0.0
-            for k in range(X.shape[1]):
-                acc += X[i, k] * H[j, k]
-            out[i, j] = acc
+@njit(cache=True, inline="always", error_model="numpy")
+def _gated_update(P, H, kc, r, y, gate, gating, force, soft, dx, U, S, Sinv):
+    """Gated update of P with m ≤ 3 rows H, noise ``R = r I`` and innovation y; returns
+    (NIS, accepted). dx += K y. H is zero beyond its first ``kc`` columns.
 
-
-@njit(cache=True)
-def _joseph(P, H, R, y, gate, gating, force, dx, soft, wk):
-    """Gated Joseph-form update of P with (H, R, y); returns (NIS, accepted). dx += K y.
-
-    ``P ← (I − KH) P (I − KH)ᵀ + K R Kᵀ``, written out for m ≤ 3 rows without
-    temporaries from BLAS. Beyond the gate a hard gate rejects; a soft gate
-    de-weights instead (R scaled by NIS/gate, a Huber-type bounded step).
-    ``wk``: work arrays PHᵀ, K, WHᵀ, KR (n × m), W (n × n), S, S⁻¹ (m × m).
+    The NIS ``yᵀ S⁻¹ y`` (``S = H U + R``, ``U = P Hᵀ``) decides first: beyond the gate
+    a hard gate rejects, a soft gate de-weights (R scaled by NIS/gate, a Huber-type
+    bounded step). Then, R being diagonal, the rows are applied one after the other,
+    which equals the joint update exactly: row j's ``u_j = P_j hⱼᵀ`` on the P the
+    earlier rows left is ``U_j − Σ_{i<j} u_i (hⱼ·u_i)/s_i`` (U's columns become the
+    u_j), ``s_j = hⱼ·u_j + r``, its gain step ``g_j = (y_j − Σ_{i<j} (hⱼ·u_i) g_i)/s_j``;
+    then ``dx += Σ u_j g_j`` and ``P ← P − Σ u_j u_jᵀ/s_j`` (symmetric). Work arrays
+    U (n × m); S and Sinv (m × m) hold the gain steps and 1/s_j in their first column
+    once the NIS is taken.
     """
     m = y.size
     n = P.shape[0]
-    PHt, K, WHt, KR, W, S, Sinv = wk
-    _mul_bt(P, H, PHt)
-    for i in range(m):
+    for i in range(n):
         for j in range(m):
-            acc = R[i, j]
-            for k in range(n):
-                acc += H[i, k] * PHt[k, j]
-            S[i, j] = acc
-    _inverse_sym(S, m, Sinv)
+            acc = 0.0
+            for k in range(kc):
+                acc += P[i, k] * H[j, k]
+            U[i, j] = acc
     nis = 0.0
-    for i in range(m):
-        for j in range(m):
-            nis += y[i] * Sinv[i, j] * y[j]
-    scale = 1.0
-    if gating and nis > gate and not force:
-        if not soft:
-            return nis, False
-        scale = nis / gate
+    if gating and not force:
         for i in range(m):
             for j in range(m):
-                S[i, j] += (scale - 1.0) * R[i, j]
+                acc = r if i == j else 0.0
+                for k in range(kc):
+                    acc += H[i, k] * U[k, j]
+                S[i, j] = acc
         _inverse_sym(S, m, Sinv)
-    for i in range(n):
-        for j in range(m):
-            acc = 0.0
-            for k in range(m):
-                acc += PHt[i, k] * Sinv[k, j]
-            K[i, j] = acc
-    # W = (I − KH) P = P − K (HP), HP = PHtᵀ
-    for i in range(n):
-        for j in range(n):
-            acc = P[i, j]
-            for k in range(m):
-                acc -= K[i, k] * PHt[j, k]
-            W[i, j] = acc
-    # P = W (I − KH)ᵀ + K R Kᵀ = W − (W Hᵀ) Kᵀ + K R Kᵀ
-    _mul_bt(W, H, WHt)
-    for i in range(n):
-        for j in range(m):
-            acc = 0.0
-            for k in range(m):
-                acc += K[i, k] * R[k, j] * scale
-            KR[i, j] = acc
-    for i in range(n):
-        for j in range(n):
-            acc = W[i, j]
-            for k in range(m):
-                acc += (KR[i, k] - WHt[i, k]) * K[j, k]
-            P[i, j] = acc
-    for i in range(n):
-        acc = 0.0
-        for k in range(m):
-            acc += K[i, k] * y[k]
-        dx[i] += acc
+        for i in range(m):
+            for j in range(m):
+                nis += y[i] * Sinv[i, j] * y[j]
+        if nis > gate:
+            if not soft:
+                return nis, False
+            r *= nis / gate
+    for j in range(m):
+        innov = y[j]
+        for i in range(j):
+            hu = 0.0
+            for k in range(kc):
+                hu += H[j, k] * U[k, i]
+            innov -= hu * S[i, 0]  # S[i, 0]: row i's gain step
+            c = hu * Sinv[i, 0]  # Sinv[i, 0]: 1 / s_i
+            for k in range(n):
+                U[k, j] -= U[k, i] * c
+        sj = r
+        for k in range(kc):
+            sj += H[j, k] * U[k, j]
+        Sinv[j, 0] = 1.0 / sj
+        S[j, 0] = innov * Sinv[j, 0]
+    for j in range(m):
+        gj = S[j, 0]
+        ij = Sinv[j, 0]
+        for i in range(n):
+            dx[i] += U[i, j] * gj
+            ui = U[i, j] * ij
+            for k in range(n):
+                P[i, k] -= ui * U[k, j]
     return nis, True
 
 
-@njit(cache=True, inline="always")
-def _joseph_work(nx, m):
-    """Work arrays of :func:`_joseph` for m measurement rows."""
-    return (np.empty((nx, m)), np.empty((nx, m)), np.empty((nx, m)), np.empty((nx, m)),
-            np.empty((nx, nx)), np.empty((m, m)), np.empty((m, m)))
-
-
-@njit(cache=True, inline="always")
-def _scaled_identity(R, num, den):
-    """R ← (I · num) / den, element by element (as ``np.eye(m) * num / den``)."""
-    m = R.shape[0]
-    for i in range(m):
-        for j in range(m):
-            R[i, j] = ((1.0 if i == j else 0.0) * num) / den
-
-
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _recovery_due(gating, clean, bad_since, tk, limit):
     """Innovations have failed the gate for longer than ``limit`` while the sensor looks clean."""
     return gating and clean and bad_since >= 0.0 and tk - bad_since > limit
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _outcome(ok, tk, bad_since, used, rejected):
     """Flag bits and the start of the current run of rejections after one gated update."""
     if ok:
@@ -414,7 +424,7 @@ def _outcome(ok, tk, bad_since, used, rejected):
     return rejected, tk if bad_since < 0.0 else bad_since
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _sub_hdx(y, H, dx):
     """y −= H dx."""
     for i in range(y.size):
@@ -429,7 +439,7 @@ def _sub_hdx(y, H, dx):
 # the module docstring): arrays one by one, last uses unconditional, no allocation.
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _n_epochs(prop, offsets, n_x, n_samples):
     """Epochs of the main scheme (the sliding start-up steps not counted)."""
     if prop.rk4:
@@ -439,7 +449,7 @@ def _n_epochs(prop, offsets, n_x, n_samples):
     return 0
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _startup_step(k, x, h, start_c, q, bias, phi, tmp):
     """Stage 1, sliding start-up: output ``k`` by one single-period step (pair coefficient
     ``start_c``) from output ``k − 1``; returns the step length."""
@@ -458,7 +468,7 @@ def _startup_step(k, x, h, start_c, q, bias, phi, tmp):
     return h
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _rk4_step(e, x, h, q, bias, phi, tmp, rates, rk, ry):
     """Stage 1, RK4: epoch e of the 2td quaternion RK4 (output at sample 2e + 2) on the
     bias-corrected rates; returns (k, T)."""
@@ -476,7 +486,7 @@ def _rk4_step(e, x, h, q, bias, phi, tmp, rates, rk, ry):
     return k, T
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _window_step(e, x, h, prop, offsets, weights, pi, pj, pc, ring, q, bias, phi, tmp, base,
                  nodes, bias_x):
     """Stage 1, windowed form: epoch e (conventional, or sliding from the base ``lag``
@@ -496,7 +506,7 @@ def _window_step(e, x, h, prop, offsets, weights, pi, pj, pc, ring, q, bias, phi
     return b + prop.end_off, prop.stride * h
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _fold_rest_samples(last, k, ema_n, rest_alpha, x, acc, h, is_rate, gm, g2, am, a2):
     """Stage 2: fold samples last + 1 … k into the rest detector's exponential moving
     averages of gyro and accelerometer (and of their squares); returns (last, ema_n)."""
@@ -513,7 +523,7 @@ def _fold_rest_samples(last, k, ema_n, rest_alpha, x, acc, h, is_rate, gm, g2, a
     return last, ema_n
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _process_noise(T, params):
     """Stage 3, the terms of ``Φ`` and ``Q`` over a step T (scalars): the manoeuvre
     state's decay e^{−T/τ} and the variances added to attitude, gyro bias, manoeuvre
@@ -524,11 +534,11 @@ def _process_noise(T, params):
             params.acc_bias_rw ** 2 * T)
 
 
-@njit(cache=True, inline="always")
-def _propagate_covariance(P, phi, T, decay, qg, qb, qa, qab, A, M):
-    """Stage 3: ``P ← Φ P Φᵀ + Q`` with Φ = [[exp(−[φ×]), −T I, 0], [0, I, 0],
-    [0, 0, decay I]] (and an identity block for an accelerometer bias when P is
-    12 × 12), exp(−[φ×]) ≈ I − [φ×] + ½[φ×]²; work arrays A (3 × 3), M (n × n)."""
+@njit(cache=True, inline="always", error_model="numpy")
+def _propagate_covariance(P, phi, T, decay, singer, A, M):
+    """Stage 3: ``P ← Φ P Φᵀ`` with Φ = [[exp(−[φ×]), −T I], [0, I]] on attitude and gyro
+    bias, ``decay I`` on the Singer state (``singer``: rows 6–8) and I on the
+    accelerometer bias, exp(−[φ×]) ≈ I − [φ×] + ½[φ×]²; work arrays A (3 × 3), M (n × n)."""
     px, py, pz = phi[0], phi[1], phi[2]
     # A = I − [φ×] + ½[φ×]²
     A[0, 0] = 1.0 - 0.5 * (py * py + pz * pz)
@@ -545,27 +555,39 @@ def _propagate_covariance(P, phi, T, decay, qg, qb, qa, qab, A, M):
         for r in range(3):
             M[r, c] = (A[r, 0] * P[0, c] + A[r, 1] * P[1, c] + A[r, 2] * P[2, c]
                        - T * P[3 + r, c])
-            M[3 + r, c] = P[3 + r, c]
-            M[6 + r, c] = decay * P[6 + r, c]
-            if nx > 9:
-                M[9 + r, c] = P[9 + r, c]
-    for r in range(nx):  # (Φ P) Φᵀ
-        for c in range(3):
-            P[r, c] = (M[r, 0] * A[c, 0] + M[r, 1] * A[c, 1] + M[r, 2] * A[c, 2]
+        for r in range(3, nx):
+            M[r, c] = (decay if singer and 6 <= r < 9 else 1.0) * P[r, c]
+    for r in range(nx):  # (Φ P) Φᵀ, symmetric: the upper triangle, mirrored
+        for c in range(min(r + 1, 3)):
+            P[c, r] = (M[r, 0] * A[c, 0] + M[r, 1] * A[c, 1] + M[r, 2] * A[c, 2]
                        - T * M[r, 3 + c])
-            P[r, 3 + c] = M[r, 3 + c]
-            P[r, 6 + c] = decay * M[r, 6 + c]
-            if nx > 9:
-                P[r, 9 + c] = M[r, 9 + c]
+            P[r, c] = P[c, r]
+        for c in range(3, r + 1):
+            P[c, r] = (decay if singer and 6 <= c < 9 else 1.0) * M[r, c]
+            P[r, c] = P[c, r]
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _add_process_noise(P, C, phi, T, qg, qb, qa, qab, params, singer):
+    """Stage 3: ``P += Q``. The attitude gets the gyro's white noise and, for the gyro's
+    scale-factor and misalignment errors, ``tilt_rate_noise² |ω|² T`` on the two tilt
+    axes only (horizontal in the reference frame: ``I − c cᵀ`` in the body frame with
+    c = C₃ᵀ, the vertical), so a fast rotation lets the accelerometer correct tilt
+    sooner without opening the heading to magnetic disturbances."""
+    qs = params.tilt_rate_noise ** 2 * (phi[0] ** 2 + phi[1] ** 2 + phi[2] ** 2) / T
     for r in range(3):
-        P[r, r] += qg
+        for c in range(3):
+            P[r, c] += ((qg + qs) if r == c else 0.0) - qs * C[2, r] * C[2, c]
+    nx = P.shape[0]
+    for r in range(3):
         P[3 + r, 3 + r] += qb
-        P[6 + r, 6 + r] += qa
-        if nx > 9:
-            P[9 + r, 9 + r] += qab
+        if singer:
+            P[6 + r, 6 + r] += qa
+        if nx > (9 if singer else 6):
+            P[nx - 3 + r, nx - 3 + r] += qab
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _rest_detect(ema_n, rest_alpha, params, gm, g2, am, a2):
     """Stage 4, detection from the moving averages; returns (acc_quiet, at_rest).
 
@@ -586,16 +608,16 @@ def _rest_detect(ema_n, rest_alpha, params, gm, g2, am, a2):
     return acc_quiet, at_rest
 
 
-@njit(cache=True, inline="always")
-def _rest_model(T, params, bias, gm, dx, R, y):
+@njit(cache=True, inline="always", error_model="numpy")
+def _rest_model(params, bias, gm, dx, y):
     """Stage 4, measurement: the zero-rate measurement of the gyro bias (at rest the
-    gyro's mean is its bias; ``H = [0, I, 0]``, fixed): R and the innovation y."""
-    _scaled_identity(R, params.rest_noise ** 2, T)
+    gyro's mean is its bias; ``H = [0, I, 0]``, fixed; ``R = rest_noise²/T I``): the
+    innovation y."""
     for a in range(3):
         y[a] = gm[a] - (bias[a] + dx[3 + a])
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _acc_recovery(params, P):
     """Stage 5, recovery: inflate the tilt covariance (and, in the raw model, the
     manoeuvre acceleration's); returns its flag."""
@@ -607,32 +629,59 @@ def _acc_recovery(params, P):
     return F_ACC_RECOVERED
 
 
-@njit(cache=True, inline="always")
-def _acc_lowpass_model(T, lp_init, params, C, fk, fn, lp, dx, H, R, y):
-    """Stage 5, low-pass accelerometer model (the idea of Laidig & Seel (2023) — VQF):
-    the specific force in the reference frame, averaged over τ, is gravity
-    (manoeuvres average out); ``lp − g_up ≈ [g_up×] C δθ`` (horizontal rows).
-    Updates the average ``lp`` and fills H, R and the innovation y."""
+@njit(cache=True, inline="always", error_model="numpy")
+def _lowpass(x, n, n_init, b0, b1, b2, a1, a2, s0, s1, out):
+    """One step of a second-order low-pass (direct form II transposed) over the vector x
+    into ``out``; returns the updated count n. The first ``n_init`` steps average
+    instead, then start the filter in that steady state (Laidig & Seel (2023), VQF's
+    ``filterVec``; ``s1`` holds the running sum meanwhile)."""
+    m = x.size
+    if n < n_init:
+        n += 1
+        for a in range(m):
+            s1[a] += x[a]
+            out[a] = s1[a] / n
+        if n == n_init:
+            for a in range(m):
+                s0[a] = out[a] * (1.0 - b0)
+                s1[a] = out[a] * (b2 - a2)
+        return n
+    for a in range(m):
+        yv = b0 * x[a] + s0[a]
+        s0[a] = b1 * x[a] - a1 * yv + s1[a]
+        s1[a] = b2 * x[a] - a2 * yv
+        out[a] = yv
+    return n
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _acc_lowpass_model(lp_n, params, C, fk, fn, lp, s0, s1, dx, H, y):
+    """Stage 5, low-pass accelerometer model (Laidig & Seel (2023) — VQF's): the specific
+    force rotated into the reference frame and low-passed (second-order Butterworth of
+    time constant ``acc_lowpass_s``, :func:`_lowpass`) is gravity — manoeuvres average
+    out; ``lp − g_up ≈ [g_up×] C δθ`` (horizontal rows). The low-pass states follow
+    every correction (:func:`_reset`), so the filter runs in an almost-inertial frame.
+    Updates ``lp`` and fills H and the innovation y (``R = acc_lowpass_noise²/T I``);
+    returns the count."""
     g = params.gravity
     nx = H.shape[1]
     for a in range(3):
         fn[a] = C[a, 0] * fk[0] + C[a, 1] * fk[1] + C[a, 2] * fk[2]
-    al = min(1.0, T / params.acc_lowpass_s)
-    for a in range(3):
-        lp[a] = lp[a] + al * (fn[a] - lp[a]) if lp_init else fn[a]
+    lp_n = _lowpass(fn, lp_n, params.lp_init_n, params.lp_b0, params.lp_b1, params.lp_b2,
+                    params.lp_a1, params.lp_a2, s0, s1, lp)
     for a in range(3):
         H[0, a] = -g * C[1, a]
         H[1, a] = g * C[0, a]
-        if nx > 9:  # the residual accelerometer bias, seen in the reference frame
-            H[0, 9 + a] = C[0, a]
-            H[1, 9 + a] = C[1, a]
+        if nx > 6:  # the residual accelerometer bias, seen in the reference frame
+            H[0, nx - 3 + a] = C[0, a]
+            H[1, nx - 3 + a] = C[1, a]
     y[0] = lp[0]
     y[1] = lp[1]
     _sub_hdx(y, H, dx)
-    _scaled_identity(R, params.acc_lowpass_noise ** 2, T)
+    return lp_n
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _acc_plausible(fk, params):
     """Raw model: the specific force's norm is g within ``acc_norm_tol`` (always, without
     gating)."""
@@ -641,7 +690,7 @@ def _acc_plausible(fk, params):
     return not (params.gating and abs(fa - g) > params.acc_norm_tol * g)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _lever_sigma(k, x, h, is_rate, bias, lever_arm):
     """Raw model: the standard deviation that rotation seen at a lever arm adds to the
     accelerometer noise (centripetal ``|ω|²`` plus tangential ``|ω̇|``, times the arm)."""
@@ -656,11 +705,11 @@ def _lever_sigma(k, x, h, is_rate, bias, lever_arm):
     return lever_arm * (w2 + np.sqrt(wd2))
 
 
-@njit(cache=True, inline="always")
-def _acc_raw_model(T, lever, params, accel, C, fk, v, dx, H, R, y):
+@njit(cache=True, inline="always", error_model="numpy")
+def _acc_raw_model(params, accel, C, fk, v, dx, H, y):
     """Stage 5, raw accelerometer model (Wang, Wang & Wang): ``f = C_b_n g_up + a_b``,
-    ``H = [[v̂×], 0, I (, I)]``, the noise widened by ``lever``
-    (:func:`_lever_sigma`): fills H, R and the innovation y."""
+    ``H = [[v̂×], 0, I (, I)]`` (the noise, ``acc_noise²/T`` widened by the lever
+    term of :func:`_lever_sigma`, is the caller's): fills H and the innovation y."""
     g = params.gravity
     nx = H.shape[1]
     for a in range(3):
@@ -678,21 +727,71 @@ def _acc_raw_model(T, lever, params, accel, C, fk, v, dx, H, R, y):
     for a in range(3):
         y[a] = fk[a] - (v[a] + accel[a])
     _sub_hdx(y, H, dx)
-    _scaled_identity(R, params.acc_noise ** 2 / T + lever * lever, 1.0)
 
 
-@njit(cache=True, inline="always")
-def _mag_plausible(mn, nb, params):
-    """Stage 6, plausibility: the field's norm ``nb`` and the dip of ``mn`` (the field in
-    the reference frame; rad, down positive) agree with the reference within the
-    tolerances."""
-    mh = np.sqrt(mn[0] ** 2 + mn[1] ** 2)
-    dip = np.arctan2(-mn[2], mh)
-    return not (abs(nb - params.ref_norm) > params.mag_norm_tol * params.ref_norm
-                or abs(dip - params.ref_dip) > params.mag_dip_tol)
+@njit(cache=True, inline="always", error_model="numpy")
+def _delayed_field(ringC, j, mag, k, mn):
+    """Stage 6: the field sample k in the reference frame, ``mn = C_j m_k`` with the
+    attitude ``ringC[j]`` of ``mag_delay`` epochs earlier (the magnetometer lags the
+    gyro); returns its norm."""
+    for a in range(3):
+        mn[a] = ringC[j, a, 0] * mag[k, 0] + ringC[j, a, 1] * mag[k, 1] + ringC[j, a, 2] * mag[k, 2]
+    return np.sqrt(mn[0] ** 2 + mn[1] ** 2 + mn[2] ** 2)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
+def _store_dcm(ringC, j, C):
+    """Stage 6: ring row j ← C."""
+    for a in range(3):
+        for b in range(3):
+            ringC[j, a, b] = C[a, b]
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _mag_disturbance(T, rate, params, nd, ms):
+    """Stage 6: the magnetic-disturbance state ``ms`` (indices ``M_*``) after one sample
+    whose low-passed norm and dip are ``nd`` (after Laidig & Seel (2023), Sec. 2.5).
+
+    Undisturbed when norm and dip agree with the reference within the tolerances for
+    ``mag_settle_s``; then the reference follows them slowly (gain ``mag_ref_k``). A new
+    field is accepted as the reference when a candidate stays consistent for
+    ``mag_new_s`` seconds of rotation faster than ``mag_new_min_rate`` (a move to
+    another place, not a magnet that turns with the sensor). The time rejected grows
+    while disturbed and shrinks ``mag_disturbed_factor`` times faster otherwise.
+    Returns True when disturbed.
+    """
+    kr = params.mag_ref_k
+    tol_n = params.mag_norm_tol
+    tol_d = params.mag_dip_tol
+    if abs(nd[0] - ms[M_NORM]) < tol_n * ms[M_NORM] and abs(nd[1] - ms[M_DIP]) < tol_d:
+        ms[M_UNDIST] += T
+        if ms[M_UNDIST] >= params.mag_settle_s:
+            ms[M_DIST] = 0.0
+            ms[M_NORM] += kr * (nd[0] - ms[M_NORM])
+            ms[M_DIP] += kr * (nd[1] - ms[M_DIP])
+    else:
+        ms[M_UNDIST] = 0.0
+        ms[M_DIST] = 1.0
+    if abs(nd[0] - ms[M_CNORM]) < tol_n * ms[M_CNORM] and abs(nd[1] - ms[M_CDIP]) < tol_d:
+        if rate >= params.mag_new_min_rate:
+            ms[M_CT] += T
+        ms[M_CNORM] += kr * (nd[0] - ms[M_CNORM])
+        ms[M_CDIP] += kr * (nd[1] - ms[M_CDIP])
+        if ms[M_DIST] > 0.0 and ms[M_CT] >= params.mag_new_s:
+            ms[M_NORM] = ms[M_CNORM]
+            ms[M_DIP] = ms[M_CDIP]
+            ms[M_DIST] = 0.0
+            ms[M_UNDIST] = params.mag_settle_s
+    else:
+        ms[M_CT] = 0.0
+        ms[M_CNORM] = nd[0]
+        ms[M_CDIP] = nd[1]
+    if ms[M_DIST] == 0.0:
+        ms[M_REJECT] = max(ms[M_REJECT] - params.mag_disturbed_factor * T, 0.0)
+    return ms[M_DIST] > 0.0
+
+
+@njit(cache=True, inline="always", error_model="numpy")
 def _mag_recovery(params, P, C):
     """Stage 6, recovery: inflate the heading covariance (about the reference vertical);
     returns its flag."""
@@ -703,21 +802,62 @@ def _mag_recovery(params, P, C):
     return F_MAG_RECOVERED
 
 
-@njit(cache=True, inline="always")
-def _heading_model(T, params, C, mn, dx, H, R, y):
-    """Stage 6, measurement: the magnetometer as a heading measurement,
-    ``H = [−(C_n_b)₃ᵀ, 0, 0]``, so that a magnetic disturbance never reaches roll and
-    pitch: fills H, R and the innovation y (wrapped to ±π)."""
+@njit(cache=True, inline="always", error_model="numpy")
+def _heading_model(params, C, mn, dx, H, y):
+    """Stage 6, measurement: the heading of the field's horizontal part. Its Jacobian
+    has the heading row ``−(C_n_b)₃`` and, through the field's dip, the tilt rows
+    ``(m_z/m_h²)(m_x (C_n_b)₁ + m_y (C_n_b)₂)``: a tilt error about the field's
+    horizontal direction shifts the measured heading by tan(dip) times itself.
+    :func:`_consider_update` counts that in the innovation variance but keeps the
+    update off roll and pitch. Fills H and the innovation y (wrapped to ±π); the
+    noise is ``heading_noise²/T`` (times ``mag_disturbed_factor`` while disturbed)."""
+    mh2 = mn[0] * mn[0] + mn[1] * mn[1]
+    cx = mn[2] * mn[0] / mh2
+    cy = mn[2] * mn[1] / mh2
     for a in range(3):
-        H[0, a] = -C[2, a]
+        H[0, a] = cx * C[0, a] + cy * C[1, a] - C[2, a]
     yv = np.arctan2(mn[1], mn[0]) - params.ref_heading
-    y[0] = (yv + np.pi) % (2.0 * np.pi) - np.pi
+    if yv > np.pi:  # atan2 and the reference are in [−π, π]: one turn at most
+        yv -= 2.0 * np.pi
+    elif yv < -np.pi:
+        yv += 2.0 * np.pi
+    y[0] = yv
     _sub_hdx(y, H, dx)
-    _scaled_identity(R, params.heading_noise ** 2, T)
 
 
-@njit(cache=True, inline="always")
-def _reset(slot, q, ring, bias, accel, acc_bias, P, C, dx, eps):
+@njit(cache=True, inline="always", error_model="numpy")
+def _consider_update(P, H, r, y, gate, gating, force, dx, C, u, K):
+    """A gated scalar update whose gain is kept off roll and pitch; returns (NIS, accepted).
+
+    ``S = H P Hᵀ + r`` with the full H (heading and, through the dip, tilt), so the
+    heading measurement weighs less while the tilt is uncertain; the gain
+    ``K = P Hᵀ / S`` is then projected: its attitude part onto the reference vertical
+    (c = C₃ᵀ in the body frame), zero on states beyond the gyro bias, and P takes the
+    Joseph form for that gain, ``P − K uᵀ − u Kᵀ + S K Kᵀ`` (u = P Hᵀ), exact for any
+    gain. dx += K y. Work arrays u, K (n,).
+    """
+    n = P.shape[0]
+    for i in range(n):
+        acc = 0.0
+        for k in range(3):
+            acc += P[i, k] * H[0, k]
+        u[i] = acc
+    S = r + H[0, 0] * u[0] + H[0, 1] * u[1] + H[0, 2] * u[2]
+    nis = y[0] * y[0] / S
+    if gating and nis > gate and not force:
+        return nis, False
+    kz = (C[2, 0] * u[0] + C[2, 1] * u[1] + C[2, 2] * u[2]) / S
+    for i in range(n):
+        K[i] = C[2, i] * kz if i < 3 else (u[i] / S if i < 6 else 0.0)
+    for i in range(n):
+        for j in range(n):
+            P[i, j] += S * K[i] * K[j] - K[i] * u[j] - u[i] * K[j]
+        dx[i] += K[i] * y[0]
+    return nis, True
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _reset(slot, q, ring, bias, accel, acc_bias, P, C, dx, eps, singer):
     """Stage 7: inject the correction dx into the estimate and symmetrise P.
 
     The attitude error, rotated into the reference frame (ε = C δθ_b, left in
@@ -736,9 +876,10 @@ def _reset(slot, q, ring, bias, accel, acc_bias, P, C, dx, eps):
     nx = dx.size
     for a in range(3):
         bias[a] += dx[3 + a]
-        accel[a] += dx[6 + a]
-        if nx > 9:
-            acc_bias[a] += dx[9 + a]
+        if singer:
+            accel[a] += dx[6 + a]
+        if nx > (9 if singer else 6):
+            acc_bias[a] += dx[nx - 3 + a]
     for i in range(nx):  # P ← ½ (P + Pᵀ) in place (a + b = b + a exactly)
         for j in range(i + 1, nx):
             s = 0.5 * (P[i, j] + P[j, i])
@@ -750,7 +891,7 @@ def _reset(slot, q, ring, bias, accel, acc_bias, P, C, dx, eps):
 # stages are the inlined functions above; moving more of the loop into them would pass the
 # records into stages, which numba's reference counting makes about 2× slower (see the
 # module docstring).
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def ekf_kernel(sensors, prop, window, params, init, out):
     """Run the filter over the record; returns the number of output rows written.
 
@@ -762,8 +903,10 @@ def ekf_kernel(sensors, prop, window, params, init, out):
     x, acc, mag, h = sensors.x, sensors.acc, sensors.mag, sensors.h
     offsets, weights, pi, pj, pc = window.offsets, window.weights, window.pi, window.pj, window.pc
     is_rate, lag = prop.is_rate, prop.lag
-    nx = init.P.shape[0]  # 9, or 12 with the accelerometer bias
-    out_q, out_b, out_a, out_ab, out_idx, out_flags, out_nis, out_sig = out
+    nx = init.P.shape[0]  # 6; 9 with the Singer state (raw model); + 3 with the acc bias
+    singer = not params.acc_lowpass
+    (out_q, out_b, out_a, out_ab, out_idx, out_flags, out_nis, out_sig, out_cov,
+     out_bv) = out
     # the estimate: attitude, gyro bias, manoeuvre acceleration, accelerometer bias,
     # covariance, and the outputs of the last `lag` epochs (the sliding bases; with
     # lag 1 the row is q itself)
@@ -796,13 +939,16 @@ def ekf_kernel(sensors, prop, window, params, init, out):
     ema_n = 0.0
     last = 0  # last sample folded into the rest detector
     # measurement work: C_n_b, the epoch's error-state correction, bias-corrected
-    # specific force (body, reference frame), its average (low-pass model), the field in
-    # the reference frame, H, R, y and the Joseph work arrays per row count
+    # specific force (body, reference frame), its low-pass and the low-pass states, the
+    # field in the reference frame, H, R, y and the update work arrays
     C = np.empty((3, 3))
     dx = np.zeros(nx)
     fk = np.empty(3)
     fn = np.zeros(3)
     lp = np.zeros(3)
+    lp_s0 = np.zeros(3)
+    lp_s1 = np.zeros(3)
+    lp_n = 0
     mn = np.empty(3)
     v = np.empty(3)
     eps = np.empty(3)
@@ -812,19 +958,37 @@ def ekf_kernel(sensors, prop, window, params, init, out):
     H_raw = np.zeros((3, nx))
     H_lp = np.zeros((2, nx))
     H_mag = np.zeros((1, nx))
-    R3 = np.empty((3, 3))
-    R2 = np.empty((2, 2))
-    R1 = np.empty((1, 1))
     y3 = np.empty(3)
     y2 = np.empty(2)
     y1 = np.empty(1)
-    wk3 = _joseph_work(nx, 3)
-    wk2 = _joseph_work(nx, 2)
-    wk1 = _joseph_work(nx, 1)
-    lp_init = False
+    ku = np.empty(nx)
+    kk = np.empty(nx)
+    U3 = np.empty((nx, 3))
+    U2 = np.empty((nx, 2))
+    S3 = np.empty((3, 3))
+    Si3 = np.empty((3, 3))
+    S2 = np.empty((2, 2))
+    Si2 = np.empty((2, 2))
+    # the magnetometer: the attitudes of the last mag_delay epochs, the low-passed norm
+    # and dip and their filter, the disturbance state (M_* indices)
+    n_delay = params.mag_delay + 1
+    ringC = np.empty((n_delay, 3, 3))
+    _dcm(init.q, C)
+    for j in range(n_delay):
+        _store_dcm(ringC, j, C)
+    nd_raw = np.empty(2)
+    nd = np.empty(2)
+    mc_s0 = np.zeros(2)
+    mc_s1 = np.zeros(2)
+    mc_n = 0
+    ms = np.zeros(8)
+    ms[M_NORM] = params.ref_norm
+    ms[M_DIP] = params.ref_dip
+    ms[M_CNORM] = params.ref_norm
+    ms[M_CDIP] = params.ref_dip
+    ms[M_UNDIST] = params.mag_settle_s
     acc_bad_since = -1.0  # start of the current run of rejections (−1: none)
     mag_bad_since = -1.0
-    mag_clean_since = -1.0  # start of the current run of plausible magnetometer samples
     e = 0
     # start-up outputs of the sliding scheme (samples 1 … lag−1 by single-period steps)
     n_start = lag - 1 if lag > 1 else 0
@@ -847,17 +1011,19 @@ def ekf_kernel(sensors, prop, window, params, init, out):
         # stages 2, 3: rest detector, covariance
         last, ema_n = _fold_rest_samples(last, k, ema_n, rest_alpha, x, acc, h, is_rate,
                                          gm, g2, am, a2)
+        _dcm(q, C)
         decay, qg, qb, qa, qab = _process_noise(T, params)
-        _propagate_covariance(P, phi, T, decay, qg, qb, qa, qab, A, M)
+        _propagate_covariance(P, phi, T, decay, singer, A, M)
+        _add_process_noise(P, C, phi, T, qg, qb, qa, qab, params, singer)
         flags = 0
         dx[:] = 0.0
         tk = k * h
-        _dcm(q, C)
         # stage 4: rest
         acc_quiet, at_rest = _rest_detect(ema_n, rest_alpha, params, gm, g2, am, a2)
         if params.rest_update and at_rest:
-            _rest_model(T, params, bias, gm, dx, R3, y3)
-            _joseph(P, H_rest, R3, y3, 0.0, False, True, dx, False, wk3)
+            _rest_model(params, bias, gm, dx, y3)
+            _gated_update(P, H_rest, 6, params.rest_noise ** 2 / T, y3, 0.0, False, True, False,
+                          dx, U3, S3, Si3)
             flags |= F_REST
         # stage 5: accelerometer (recovery, then the accelerometer model's update)
         nis_acc = np.nan
@@ -869,65 +1035,79 @@ def ekf_kernel(sensors, prop, window, params, init, out):
             if force:
                 flags |= _acc_recovery(params, P)
             if params.acc_lowpass:
-                _acc_lowpass_model(T, lp_init, params, C, fk, fn, lp, dx, H_lp, R2, y2)
-                lp_init = True
-                nis_acc, ok = _joseph(P, H_lp, R2, y2, params.acc_gate_lowpass, params.gating,
-                                      force, dx, params.soft_gate, wk2)
+                lp_n = _acc_lowpass_model(lp_n, params, C, fk, fn, lp, lp_s0, lp_s1, dx, H_lp,
+                                          y2)
+                nis_acc, ok = _gated_update(P, H_lp, 3 if nx == 6 else nx,
+                                            params.acc_lowpass_noise ** 2 / T, y2,
+                                            params.acc_gate_lowpass, params.gating, force,
+                                            params.soft_gate, dx, U2, S2, Si2)
                 disturbed = False
             else:
                 disturbed = not _acc_plausible(fk, params)
                 ok = False
                 if not disturbed:
                     lever = _lever_sigma(k, x, h, is_rate, bias, params.lever_arm)
-                    _acc_raw_model(T, lever, params, accel, C, fk, v, dx, H_raw, R3, y3)
-                    nis_acc, ok = _joseph(P, H_raw, R3, y3, params.acc_gate, params.gating,
-                                          force, dx, params.soft_gate, wk3)
+                    _acc_raw_model(params, accel, C, fk, v, dx, H_raw, y3)
+                    nis_acc, ok = _gated_update(P, H_raw, nx, params.acc_noise ** 2 / T
+                                                + lever * lever, y3, params.acc_gate,
+                                                params.gating, force, params.soft_gate, dx, U3,
+                                                S3, Si3)
             if disturbed:
                 flags |= F_ACC_DISTURBED
             else:
                 bits, acc_bad_since = _outcome(ok, tk, acc_bad_since, F_ACC_USED,
                                                F_ACC_REJECTED)
                 flags |= bits
-        # stage 6: magnetometer (plausibility, settling, recovery, the heading update)
+        # stage 6: magnetometer (delay, disturbance, rejection or de-weighting, recovery,
+        # the heading update)
         nis_mag = np.nan
         if params.use_magnetometer:
-            for a in range(3):
-                mn[a] = C[a, 0] * mag[k, 0] + C[a, 1] * mag[k, 1] + C[a, 2] * mag[k, 2]
-            nb = np.sqrt(mag[k, 0] ** 2 + mag[k, 1] ** 2 + mag[k, 2] ** 2)
-            if _mag_plausible(mn, nb, params):
-                if mag_clean_since < 0.0:
-                    mag_clean_since = tk
-                settling = tk - mag_clean_since < params.mag_settle_s
-            else:
-                mag_clean_since = -1.0
-                settling = True
-            if params.gating and settling:
+            _store_dcm(ringC, step % n_delay, C)
+            nb = _delayed_field(ringC, (step + 1) % n_delay, mag, k, mn)
+            nd_raw[0] = nb
+            nd_raw[1] = -np.arcsin(min(max(mn[2] / nb, -1.0), 1.0)) if nb > 0.0 else 0.0
+            mc_n = _lowpass(nd_raw, mc_n, params.mc_init_n, params.mc_b0, params.mc_b1,
+                            params.mc_b2, params.mc_a1, params.mc_a2, mc_s0, mc_s1, nd)
+            rate = np.sqrt(gm[0] ** 2 + gm[1] ** 2 + gm[2] ** 2)
+            dist = params.gating and _mag_disturbance(T, rate, params, nd, ms)
+            horizontal = mn[0] ** 2 + mn[1] ** 2 > 1e-12 * nb * nb
+            if dist:
                 flags |= F_MAG_DISTURBED
-            else:
-                force = _recovery_due(params.gating, True, mag_bad_since, tk,
+            if horizontal and not (dist and ms[M_REJECT] <= params.mag_reject_s):
+                force = _recovery_due(params.gating, not dist, mag_bad_since, tk,
                                       params.recover_mag_s)
                 if force:
                     flags |= _mag_recovery(params, P, C)
-                _heading_model(T, params, C, mn, dx, H_mag, R1, y1)
-                nis_mag, ok = _joseph(P, H_mag, R1, y1, params.mag_gate, params.gating, force, dx,
-                                      False, wk1)
+                _heading_model(params, C, mn, dx, H_mag, y1)
+                nis_mag, ok = _consider_update(P, H_mag, params.heading_noise ** 2 / T
+                                               * (params.mag_disturbed_factor if dist else 1.0),
+                                               y1, params.mag_gate,
+                                               params.gating, force, dx, C, ku, kk)
                 bits, mag_bad_since = _outcome(ok, tk, mag_bad_since, F_MAG_USED,
                                                F_MAG_REJECTED)
                 flags |= bits
+            elif dist:
+                ms[M_REJECT] += T
         # stage 7: reset
         _reset((e if step >= n_start else step + 1) % lag, q, ring, bias, accel, acc_bias, P,
-               C, dx, eps)
-        if lp_init:  # the averaged reference-frame specific force follows the correction
+               C, dx, eps, singer)
+        if lp_n > 0:  # the low-passed reference-frame specific force follows the correction
             _rotate_small(eps, lp)
+            _rotate_small(eps, lp_s0)
+            _rotate_small(eps, lp_s1)
         # stage 8: record
-        out_q[step] = q
-        out_b[step] = bias
-        out_a[step] = accel
-        out_ab[step] = acc_bias
-        out_idx[step] = k
-        out_flags[step] = flags
-        out_nis[step, 0] = nis_acc
-        out_nis[step, 1] = nis_mag
+        for i in range(4):
+            out_q[k, i] = q[i]
         for a in range(3):
-            out_sig[step, a] = np.sqrt(max(P[a, a], 0.0))
+            out_b[k, a] = bias[a]
+            out_a[k, a] = accel[a]
+            out_ab[k, a] = acc_bias[a]
+            out_sig[k, a] = np.sqrt(max(P[a, a], 0.0))
+            out_bv[k, a] = P[3 + a, 3 + a]
+            for c in range(3):
+                out_cov[k, a, c] = P[a, c]
+        out_idx[step] = k
+        out_flags[k] = flags
+        out_nis[k, 0] = nis_acc
+        out_nis[k, 1] = nis_mag
     return total

@@ -65,19 +65,26 @@ Q_NED_ENU = np.array([0.0, math.sqrt(0.5), math.sqrt(0.5), 0.0])
 
 @dataclass(frozen=True)
 class AhrsConfig:
-    """Filter tuning (SI units). Defaults work on consumer MEMS IMUs at 100–1000 Hz.
+    """Filter tuning (SI units). Defaults work on consumer MEMS IMUs at 100–1000 Hz; the
+    defaults marked "(CV)" were chosen by cross-validation on BROAD (Laidig et al.
+    (2021); docs/reproductions.md gives the held-out figures).
 
     Parameters
     ----------
     gyro_noise : float
-        Gyro white-noise density (angle random walk), rad/s/√Hz. Default 5e-4
-        (≈ 0.03 °/s/√Hz: a consumer MEMS gyro with margin for model error).
+        Gyro white-noise density (angle random walk), rad/s/√Hz (CV).
     gyro_bias_rw : float
-        Bias random walk, rad/s/√s. Default 2e-5.
+        Bias random walk, rad/s/√s (CV).
     gyro_bias_sigma0 : float
         Initial bias uncertainty, rad/s. Default 0.01 (0.6 °/s).
+    tilt_rate_noise : float
+        Tilt process noise per unit rotation rate, rad/√Hz per rad/s: the gyro's
+        scale-factor and misalignment errors make the tilt more uncertain the faster
+        the sensor turns, ``Q_tilt = tilt_rate_noise² |ω|² T`` on the two horizontal
+        axes (CV; 0 switches it off).
     singer_sigma : float
-        Steady-state standard deviation of the manoeuvre acceleration, m/s². Default 2.
+        Raw model: steady-state standard deviation of the manoeuvre acceleration, m/s².
+        Default 2.
     singer_tau : float
         Its correlation time, s. Default 0.2.
     acc_noise : float
@@ -88,17 +95,17 @@ class AhrsConfig:
         propagation algorithm's update period.
     acc_model : {"lowpass", "raw"}
         ``lowpass`` (default): the specific force rotated into the reference
-        frame and averaged over ``acc_lowpass_s`` is gravity — manoeuvre
-        accelerations average out (the idea of Laidig & Seel's VQF); the
-        Singer state is then unused. ``raw``: the paper's model, each sample
-        ``f = C_b_n g_up + a_b`` with the Singer state ``a_b``.
+        frame and low-passed over ``acc_lowpass_s`` is gravity — manoeuvre
+        accelerations average out (Laidig & Seel (2023), VQF); 6 states.
+        ``raw``: the paper's model, each sample ``f = C_b_n g_up + a_b`` with the
+        Singer manoeuvre state ``a_b``; 9 states.
     acc_lowpass_s : float
-        Averaging time constant, s. Default 3.
+        Time constant of the second-order Butterworth low-pass (Laidig & Seel's
+        τ_acc, cut-off √2/(2πτ)), s (CV).
     acc_lowpass_noise : float
-        Noise density of the averaged horizontal specific force, m/s²/√Hz.
-        Default 0.018.
+        Noise density of the low-passed horizontal specific force, m/s²/√Hz (CV).
     acc_gate_lowpass : float
-        NIS gate of the averaged measurement (χ², 2 dof, 99.9 %: 13.82).
+        NIS gate of the low-passed measurement (χ², 2 dof, 99.9 %: 13.82).
     acc_gate_mode : {"hard", "soft"}
         Beyond the gate: reject (hard, default) or de-weight (soft, Huber-type).
     lever_arm : float
@@ -106,37 +113,64 @@ class AhrsConfig:
         the accelerometer noise by the centripetal and tangential accelerations
         the gyro sees. Default 0.1.
     heading_noise : float
-        Magnetometer heading noise density, rad/√Hz. Default 0.018 (local
-        field distortion dominates the sensor noise indoors).
+        Magnetometer heading noise density, rad/√Hz (CV; local field distortion
+        dominates the sensor noise indoors). The heading update's innovation
+        variance also carries the tilt uncertainty times tan(dip), and its gain never
+        reaches roll and pitch.
     acc_gate, mag_gate : float
-        NIS thresholds (χ² with 3 and 1 degrees of freedom at 99.9 %: 16.27, 10.83).
+        NIS thresholds: χ² with 3 dof at 99.9 % (16.27) for the raw accelerometer,
+        1 dof at 99 % (6.63, CV) for the heading.
     mag_norm_tol : float
-        Reject a magnetometer sample whose norm departs from the reference by
-        more than this fraction. Default 0.1.
+        The field is disturbed when its (low-passed) norm departs from the reference
+        by more than this fraction (CV) …
     mag_dip_tol : float
-        … or whose dip angle departs by more than this, rad. Default 0.1 (5.7°).
+        … or its dip angle by more than this, rad (CV).
+    mag_settle_s : float
+        The field must stay within the tolerances this long before it is undisturbed
+        again, s. Default 0.5 (Laidig & Seel's magMinUndisturbedTime).
+    mag_reference_s : float
+        Time constant with which the reference norm and dip follow an undisturbed
+        field, s. Default 20.
+    mag_current_s : float
+        Time constant of the low-pass of the field's norm and dip before they are
+        compared, s. Default 0.05.
+    mag_new_s, mag_new_min_rate : float
+        A disturbed field that stays consistent for ``mag_new_s`` seconds of rotation
+        faster than ``mag_new_min_rate`` (rad/s) becomes the new reference (a new
+        place, not a magnet that turns with the sensor). Defaults 20 s, 0.35 rad/s.
+    mag_reject_s : float
+        A disturbed field is rejected for at most this many seconds (the budget
+        refills ``mag_disturbed_factor`` times faster while undisturbed); beyond it,
+        it is used with its noise density scaled by √``mag_disturbed_factor`` (CV).
+    mag_disturbed_factor : float
+        That variance factor (CV).
+    mag_delay_s : float
+        Delay of the magnetometer behind the gyro, s: each field sample is rotated
+        with the attitude of that long ago (rounded to whole filter epochs). CV; see
+        :func:`estimate_mag_delay` for a measurement from a recording.
+    latency_s : float
+        Latency of the IMU's samples behind the motion they measure (its internal
+        filters' group delay), s: each output attitude is predicted that far ahead on
+        the bias-corrected gyro. Causal. Default 0 (no prediction).
     acc_norm_tol : float
         Raw model only: skip the accelerometer when its norm departs from g by
         more than this fraction (sustained manoeuvres, impacts). Default 0.25.
-    mag_settle_s : float
-        After a magnetic disturbance, the field must stay plausible this long
-        before it is used again, s. Default 1.
     recover_acc_s, recover_mag_s : float
         Seconds of consecutive NIS rejections of clean-looking measurements
-        (accelerometer quiet; field plausible) after which the covariance is
+        (accelerometer quiet; field undisturbed) after which the covariance is
         inflated by ``recover_angle`` and measurements are accepted again.
     recover_angle : float
         Standard deviation added on recovery, rad. Default 0.1.
     rest_gyro, rest_acc : float
         Rest when the gyro's standard deviation over ``rest_tau`` is below
         ``rest_gyro`` (rad/s) and its mean below 5 × that, and the
-        accelerometer's below ``rest_acc`` (m/s²). Defaults 0.01, 0.2.
+        accelerometer's below ``rest_acc`` (m/s²) (CV).
     rest_noise : float
         Noise density of the zero-rate bias measurement, rad/s/√Hz. Default 1.2e-4.
     rest_tau : float
         Averaging time of the rest detector, s. Default 0.5.
     estimate_acc_bias : bool
-        Add the accelerometer bias to the state (12 states). Off by default:
+        Add the accelerometer bias to the state (+3 states). Off by default:
         it is observable only through attitude changes, and a consumer IMU's
         factory calibration usually leaves less than the filter can resolve.
     acc_bias_sigma0 : float
@@ -144,7 +178,7 @@ class AhrsConfig:
     acc_bias_rw : float
         Its random walk, m/s²/√s. Default 1e-4.
     gating : bool
-        Innovation gating and magnetic-disturbance rejection (default on).
+        Innovation gating and magnetic-disturbance handling (default on).
     rest_update : bool
         Zero-rate bias updates at rest (default on).
     use_accelerometer, use_magnetometer : bool
@@ -159,30 +193,39 @@ class AhrsConfig:
         m/s². Default 9.80665.
     """
 
-    gyro_noise: float = 5e-4
-    gyro_bias_rw: float = 2e-5
+    gyro_noise: float = 1.4e-3
+    gyro_bias_rw: float = 1.8e-6
     gyro_bias_sigma0: float = 0.01
+    tilt_rate_noise: float = 0.003
     singer_sigma: float = 2.0
     singer_tau: float = 0.2
     acc_noise: float = 0.03
-    heading_noise: float = 0.018
+    heading_noise: float = 0.0126
     acc_gate: float = 16.27
-    mag_gate: float = 10.83
-    mag_norm_tol: float = 0.1
-    mag_dip_tol: float = 0.17
+    mag_gate: float = 6.63
+    mag_norm_tol: float = 0.05
+    mag_dip_tol: float = 0.1745
     acc_model: str = "lowpass"
-    acc_lowpass_s: float = 3.0
+    acc_lowpass_s: float = 2.1
     acc_lowpass_noise: float = 0.018
     acc_gate_lowpass: float = 13.82
     acc_gate_mode: str = "hard"
     lever_arm: float = 0.1
     acc_norm_tol: float = 0.25
-    mag_settle_s: float = 2.0
+    mag_settle_s: float = 0.5
+    mag_reference_s: float = 20.0
+    mag_current_s: float = 0.05
+    mag_new_s: float = 20.0
+    mag_new_min_rate: float = 0.349
+    mag_reject_s: float = 0.0
+    mag_disturbed_factor: float = 8.0
+    mag_delay_s: float = 0.0
+    latency_s: float = 0.0
     recover_acc_s: float = 2.0
     recover_mag_s: float = 10.0
     recover_angle: float = 0.1
-    rest_gyro: float = 0.01
-    rest_acc: float = 0.2
+    rest_gyro: float = 0.04
+    rest_acc: float = 0.4
     rest_noise: float = 1.2e-4
     rest_tau: float = 0.5
     estimate_acc_bias: bool = False
@@ -209,8 +252,21 @@ class AhrsConfig:
                 continue
             if not math.isfinite(v):
                 raise ValueError(f"AhrsConfig.{name} must be finite, got {v!r}")
-            if name not in ("declination_deg", "lever_arm") and not v > 0:
+            if name in _ANY_SIGN:
+                continue
+            if name in _NON_NEGATIVE:
+                if not v >= 0:
+                    raise ValueError(f"AhrsConfig.{name} must be ≥ 0, got {v!r}")
+            elif not v > 0:
                 raise ValueError(f"AhrsConfig.{name} must be positive, got {v!r}")
+        if self.mag_disturbed_factor < 1:
+            raise ValueError(f"AhrsConfig.mag_disturbed_factor must be ≥ 1, got "
+                             f"{self.mag_disturbed_factor!r}")
+
+
+#: AhrsConfig fields that may be negative, and those that may be zero.
+_ANY_SIGN = ("declination_deg",)
+_NON_NEGATIVE = ("lever_arm", "tilt_rate_noise", "mag_reject_s", "mag_delay_s", "latency_s")
 
 
 @dataclass(frozen=True)
@@ -331,8 +387,8 @@ def _check(name, a, n):
     a = np.ascontiguousarray(a, dtype=np.float64)
     if a.shape != (n, 3):
         raise ValueError(f"{name} must have shape ({n}, 3) to match the gyro, got {a.shape}")
-    bad = ~np.all(np.isfinite(a), axis=1)
-    if np.any(bad):
+    if not np.isfinite(a).all():
+        bad = ~np.all(np.isfinite(a), axis=1)
         raise ValueError(f"{name} has NaN or infinity in row {int(np.argmax(bad))}")
     return a
 
@@ -407,20 +463,45 @@ def _reference_field(rec, mag, q_init, m0, q0, mag_reference, cfg: AhrsConfig):
             math.atan2(mn[1], mn[0]))
 
 
-# Params fields that are not AhrsConfig fields of the same name and meaning
-_DERIVED = ("ref_norm", "ref_dip", "ref_heading", "use_magnetometer", "soft_gate",
-            "acc_lowpass")
+def butterworth(tau: float, ts: float) -> tuple[float, float, float, float, float]:
+    """Second-order Butterworth low-pass coefficients ``(b0, b1, b2, a1, a2)`` (a0 = 1)
+    for time constant ``tau`` at period ``ts``: cut-off ``√2/(2π tau)``, by the bilinear
+    transform (Laidig & Seel (2023), VQF's ``filterCoeffs``); a pass-through when
+    ``tau < ts/2`` (a cut-off above 90 % of Nyquist)."""
+    if tau < ts / 2:
+        return 1.0, 0.0, 0.0, 0.0, 0.0
+    c = math.tan(math.pi * math.sqrt(2.0) / (2.0 * math.pi * tau) * ts)
+    d = c * c + math.sqrt(2.0) * c + 1.0
+    b0 = c * c / d
+    return b0, 2.0 * b0, b0, 2.0 * (c * c - 1.0) / d, (1.0 - math.sqrt(2.0) * c + c * c) / d
 
 
-def _params(cfg: AhrsConfig, ref, use_mag: bool) -> K.Params:
-    """The kernel's parameter record: the config's fields of the same name, the reference
-    field ``ref`` (norm, dip, heading), and the switches derived from the config.
+def _derived(cfg: AhrsConfig, ref, use_mag: bool, te: float) -> dict:
+    """The kernel parameters that are not config fields of the same name: the reference
+    field ``ref`` (norm, dip, heading), the switches, and what depends on the epoch
+    period ``te`` — the low-pass coefficients and averaging counts, the reference's
+    gain per epoch, the magnetometer delay in epochs."""
+    lp = butterworth(cfg.acc_lowpass_s, te)
+    mc = butterworth(cfg.mag_current_s, te)
+    return {"ref_norm": ref[0], "ref_dip": ref[1], "ref_heading": ref[2],
+            "use_magnetometer": use_mag, "soft_gate": cfg.acc_gate_mode == "soft",
+            "acc_lowpass": cfg.acc_model == "lowpass",
+            **dict(zip(("lp_b0", "lp_b1", "lp_b2", "lp_a1", "lp_a2"), lp, strict=True)),
+            **dict(zip(("mc_b0", "mc_b1", "mc_b2", "mc_a1", "mc_a2"), mc, strict=True)),
+            "lp_init_n": max(1, math.ceil(cfg.acc_lowpass_s / te - 1e-9)),
+            "mc_init_n": max(1, math.ceil(cfg.mag_current_s / te - 1e-9)),
+            "mag_ref_k": 1.0 - math.exp(-te / cfg.mag_reference_s),
+            "mag_delay": round(cfg.mag_delay_s / te)}
 
-    Every value is converted to its field's type (float or bool), so the
+
+def _params(cfg: AhrsConfig, ref, use_mag: bool, te: float) -> K.Params:
+    """The kernel's parameter record: the config's fields of the same name and
+    :func:`_derived`'s for the epoch period ``te``.
+
+    Every value is converted to its field's type (float, int or bool), so the
     compiled kernel's signature — and numba's cache entry — never changes.
     """
-    derived = dict(zip(_DERIVED[:3], ref, strict=True), use_magnetometer=use_mag,
-                   soft_gate=cfg.acc_gate_mode == "soft", acc_lowpass=cfg.acc_model == "lowpass")
+    derived = _derived(cfg, ref, use_mag, te)
     types = typing.get_type_hints(K.Params)
     return K.Params(**{f: types[f](derived[f] if f in derived else getattr(cfg, f))
                        for f in K.Params._fields})
@@ -438,27 +519,38 @@ def _propagation(a: dict) -> tuple[K.Propagation, K.Window]:
 
 
 def _initial_covariance(cfg: AhrsConfig) -> np.ndarray:
-    """P0: attitude, gyro bias, manoeuvre acceleration (and accelerometer bias)."""
-    nx = 12 if cfg.estimate_acc_bias else 9
+    """P0: attitude, gyro bias (and the raw model's manoeuvre acceleration, the
+    accelerometer bias)."""
+    singer = cfg.acc_model == "raw"
+    nx = 6 + 3 * singer + 3 * cfg.estimate_acc_bias
     P0 = np.zeros((nx, nx))
     P0[:3, :3] = np.eye(3) * cfg.attitude_sigma0**2
     P0[3:6, 3:6] = np.eye(3) * cfg.gyro_bias_sigma0**2
-    P0[6:9, 6:9] = np.eye(3) * cfg.singer_sigma**2
-    if nx == 12:
-        P0[9:, 9:] = np.eye(3) * cfg.acc_bias_sigma0**2
+    if singer:
+        P0[6:9, 6:9] = np.eye(3) * cfg.singer_sigma**2
+    if cfg.estimate_acc_bias:
+        P0[-3:, -3:] = np.eye(3) * cfg.acc_bias_sigma0**2
     return P0
 
 
 def _run(rec, acc, mag, prop: K.Propagation, window: K.Window, params: K.Params,
          init: K.Initial):
-    """Run the compiled loop; returns (outputs, number of rows written)."""
+    """Run the compiled loop into per-sample outputs whose row 0 is the initial state;
+    returns (outputs, number of epochs)."""
     h = rec.td
     x = rec.omega if prop.is_rate else 0.5 * h * (rec.omega[1:] + rec.omega[:-1])
-    m = rec.t.size  # at most one output per sample
-    out = K.Outputs(q=np.empty((m, 4)), gyro_bias=np.empty((m, 3)), accel=np.empty((m, 3)),
-                    acc_bias=np.empty((m, 3)), sample=np.empty(m, np.int64),
-                    flags=np.empty(m, np.int64), nis=np.empty((m, 2)),
-                    attitude_sigma=np.empty((m, 3)))
+    n = rec.t.size
+    out = K.Outputs(q=np.empty((n, 4)), gyro_bias=np.empty((n, 3)), accel=np.zeros((n, 3)),
+                    acc_bias=np.zeros((n, 3)), sample=np.empty(n, np.int64),
+                    flags=np.zeros(n, np.int64), nis=np.empty((n, 2)),
+                    attitude_sigma=np.empty((n, 3)), attitude_cov=np.empty((n, 3, 3)),
+                    bias_var=np.empty((n, 3)))
+    out.q[0] = init.q
+    out.gyro_bias[0] = init.gyro_bias
+    out.nis[0] = np.nan
+    out.attitude_sigma[0] = np.sqrt(np.diag(init.P)[:3])
+    out.attitude_cov[0] = init.P[:3, :3]
+    out.bias_var[0] = np.diag(init.P)[3:6]
     k = K.ekf_kernel(K.Sensors(np.ascontiguousarray(x), acc, mag, float(h)), prop, window,
                      params, init, out)
     return out, k
@@ -482,39 +574,34 @@ def _fill_between_epochs(rec, q, bias, last):
         q[i] = quat_multiply(q[i - 1], quat_from_rotvec(phi))
 
 
-def _result(rec, out: K.Outputs, k: int, init: K.Initial, frame: str, have_mag: bool,
-            algorithm: str, cfg: AhrsConfig) -> AhrsResult:
-    """One row per sample (see :class:`AhrsResult`): row 0 the initial state, the k epoch
-    rows of ``out`` at their samples, the rows between propagated
-    (:func:`_fill_between_epochs`), everything else held from the last epoch."""
+def _result(rec, out: K.Outputs, k: int, frame: str, have_mag: bool, algorithm: str,
+            cfg: AhrsConfig) -> AhrsResult:
+    """One row per sample (see :class:`AhrsResult`) from the kernel's per-sample outputs:
+    rows that are neither row 0 nor an epoch get the last epoch's bias and covariance
+    and the attitude propagated from it (:func:`_fill_between_epochs`), flags 0 and no
+    NIS; the attitudes are then predicted over ``latency_s`` when it is set."""
     n = rec.t.size
-    idx = out.sample[:k]
     epoch = np.zeros(n, bool)
-    epoch[idx] = True
+    epoch[out.sample[:k]] = True
+    held = np.flatnonzero(~epoch[1:]) + 1  # rows that are neither epochs nor row 0
     rows = np.arange(n)
-    last = np.maximum.accumulate(np.where(epoch, rows, 0))  # the last epoch row (or 0)
+    q, bias = out.q, out.gyro_bias
+    if held.size:
+        last = np.maximum.accumulate(np.where(epoch, rows, 0))  # the last epoch row (or 0)
+        for a in (bias, out.accel, out.acc_bias, out.attitude_sigma, out.attitude_cov,
+                  out.bias_var):
+            a[held] = a[last[held]]
+        out.nis[held] = np.nan
+        _fill_between_epochs(rec, q, bias, last)
+    if cfg.latency_s > 0:  # predict each attitude over the sensor's latency (causal)
+        from strapdown.rotation.quaternion import quat_from_rotvec
 
-    def per_sample(first, epochs):
-        a = np.empty((n, *np.shape(first)), np.asarray(epochs).dtype)
-        a[0] = first
-        a[idx] = epochs
-        return a[last]
-
-    sigma0 = np.sqrt(np.diag(init.P)[:3])
-    bias = per_sample(init.gyro_bias, out.gyro_bias[:k])
-    q = per_sample(init.q, out.q[:k])
-    _fill_between_epochs(rec, q, bias, last)
+        q = quat_multiply(q, quat_from_rotvec((rec.omega - bias) * cfg.latency_s))
     if frame == "NED":
         q = quat_multiply(Q_NED_ENU, q)
-    flags = np.zeros(n, np.int64)
-    flags[idx] = out.flags[:k]
-    nis = np.full((n, 2), np.nan)
-    nis[idx] = out.nis[:k]
-    return AhrsResult(rec.t, rows, epoch, q, frame, have_mag, bias,
-                      per_sample(np.zeros(3), out.accel[:k]), flags, nis,
-                      per_sample(sigma0, out.attitude_sigma[:k]), algorithm, cfg,
-                      per_sample(np.zeros(3), out.acc_bias[:k]) if cfg.estimate_acc_bias
-                      else None)
+    return AhrsResult(rec.t, rows, epoch, q, frame, have_mag, bias, out.accel, out.flags,
+                      out.nis, out.attitude_sigma, algorithm, cfg,
+                      out.acc_bias if cfg.estimate_acc_bias else None)
 
 
 def ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
@@ -567,5 +654,6 @@ def ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
     b0 = np.zeros(3) if gyro_bias0 is None else _check("gyro_bias0", [gyro_bias0], 1)[0]
     prop, window = _propagation(_algorithm(algorithm))
     init = K.Initial(q_init, b0, _initial_covariance(cfg))
-    out, k = _run(rec, acc, mag, prop, window, _params(cfg, ref, have_mag), init)
-    return _result(rec, out, k, init, frame, have_mag, algorithm, cfg)
+    out, k = _run(rec, acc, mag, prop, window, _params(cfg, ref, have_mag, prop.stride * rec.td),
+                  init)
+    return _result(rec, out, k, frame, have_mag, algorithm, cfg)
