@@ -16,7 +16,7 @@ from strapdown.cli import build_parser, main
 
 #: The subcommands README.md and docs/tutorial.md document (the contract scripts rely on).
 DOCUMENTED = ("evaluate", "coefficients", "export-c", "run", "nav", "compare", "sweep", "ahrs",
-              "benchmark-ahrs", "reproduce", "bench")
+              "benchmark-ahrs", "reproduce", "bench", "advise")
 HEAVY = ("numpy", "scipy", "numba", "sympy", "matplotlib")
 
 

@@ -40,7 +40,11 @@ _SMALL_A = 1e-8
 @functools.lru_cache(maxsize=4096)
 def _kernel_one(spec_text: str, omega: float, h: float) -> float:
     spec = AlgorithmSpec.parse(spec_text)
-    d = classical_coning_drift(spec, _SMALL_A, omega * h, cone_rate=omega, digits=80)
+    try:
+        d = classical_coning_drift(spec, _SMALL_A, omega * h, cone_rate=omega, digits=80)
+    except ValueError:  # a whole cone turn per update: the mean of the two sides
+        d = sum(classical_coning_drift(spec, _SMALL_A, omega * h * (1 + e), cone_rate=omega,
+                                       digits=80) for e in (-1e-7, 1e-7)) / 2
     return 2 * d / (_SMALL_A**2 * omega**2)
 
 

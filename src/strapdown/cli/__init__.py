@@ -22,6 +22,7 @@ import sys
 import textwrap
 
 from strapdown.cli import (
+    advise,
     ahrs,
     bench,
     benchmark_ahrs,
@@ -40,7 +41,7 @@ __all__ = ["COMMANDS", "EXIT_STATUS", "build_parser", "main"]
 
 #: The subcommand modules, in the order ``strapdown --help`` lists them.
 COMMANDS = (evaluate, coefficients, export_c, run, nav, compare, sweep, ahrs, benchmark_ahrs,
-            reproduce, bench)
+            reproduce, bench, advise)
 
 EXIT_OK, EXIT_USAGE, EXIT_IO, EXIT_INTERRUPTED, EXIT_PIPE = 0, 2, 74, sweep.INTERRUPTED, 141
 

@@ -1,0 +1,118 @@
+"""``strapdown advise``: which algorithm to fly in a measured vibration environment."""
+
+from __future__ import annotations
+
+import argparse
+
+from strapdown.cli._common import columns, json_arg, log_args, print_json, say
+
+__all__ = ["add_parser", "run"]
+
+#: Operations of one triple term θ_L × (θ_(L−m) × θ_L) added to φ: a cross product
+#: (6 mul, 3 add) and a scaled cross-add (9 mul, 6 add), as export-c counts its terms.
+_TRIPLE_OPS = 24
+
+
+def add_parser(subparsers) -> argparse.ArgumentParser:
+    """Register ``advise`` (its options are added when it is used)."""
+    p = subparsers.add_parser(
+        "advise", arguments=_arguments,
+        help="rank the algorithms by predicted drift and cost for a vibration environment",
+        description="Estimate the cross-spectrum of the body rates from a gyro log (Welch) or "
+        "read it from a file, predict each candidate algorithm's drift by summing its exact "
+        "coning response over the spectrum, count its operations per second in the C export, "
+        "and name the cheapest one within the drift budget (with no coning content: the "
+        "cheapest). Prints a table, writes a figure of drift against cost with the Pareto "
+        "front, or --json: {candidates: [{spec, predicted_drift_deg_h, ops_per_s}], "
+        "recommended}.")
+    p.set_defaults(handler=run)
+    return p
+
+
+def _arguments(p: argparse.ArgumentParser) -> None:
+    from strapdown.apps.advise import PSD_COLUMNS
+
+    log_args(p, imu_help="gyro log whose vibration the algorithm must fly in", required=False,
+             sample_rate=True)
+    g = p.add_argument_group("advice")
+    g.add_argument("--psd", default=None,
+                   help=f"a cross-spectrum CSV instead of a log: {','.join(PSD_COLUMNS)} "
+                   "(imaginary parts of the one-sided CSDs, rad²/s²/Hz, conj(X)·Y); needs "
+                   "--sample-rate-hz")
+    g.add_argument("--budget-deg-h", type=float, default=None,
+                   help="drift budget (deg/h): the cheapest candidate within it is recommended")
+    g.add_argument("--max-ops", type=float, default=None,
+                   help="processor budget: candidates above this many operations per second "
+                   "are not recommended")
+    g.add_argument("--nperseg", type=int, default=256, help="Welch segment length (samples)")
+    g.add_argument("--figure", default="advise.png",
+                   help="figure of predicted drift against cost (default: advise.png)")
+    json_arg(p)
+
+
+def _ops_per_s(spec, h: float) -> float:
+    """Operations per second of ``spec`` at samples every ``h``: the C exporter's counts per
+    update (every arithmetic operation and libm call) times the updates per second."""
+    from dataclasses import replace
+
+    from strapdown.codegen.export_c import generate
+
+    triple = spec.resolved_coefficients == "finite-amplitude"
+    base = replace(spec, coefficients=None) if triple else spec
+    exp = generate(base.algorithm, structure=base.structure, subsamples=base.subsamples,
+                   coefficients=base.coefficients, h=h)
+    ops = sum(exp.ops.values()) + (_TRIPLE_OPS * (spec.subsamples - 1) if triple else 0)
+    return ops / spec.update_period(h)
+
+
+def _spectrum(args: argparse.Namespace):
+    """(frequencies, CSDs, h, Welch segments or None, input kind or None)."""
+    from strapdown.apps.advise import log_spectrum, read_psd
+
+    if (args.imu is None) == (args.psd is None):
+        raise ValueError("give one of --imu LOG or --psd FILE")
+    if args.psd is not None:
+        if args.sample_rate_hz is None or not args.sample_rate_hz > 0:
+            raise ValueError("--psd needs --sample-rate-hz (the rate the algorithm runs at)")
+        f, g = read_psd(args.psd)
+        return f, g, 1.0 / args.sample_rate_hz, None, None
+    if args.kind is None:
+        raise ValueError("--imu needs --rates or --increments")
+    if args.nperseg < 16:
+        raise ValueError(f"--nperseg must be at least 16, got {args.nperseg}")
+    from strapdown.io import read_imu
+
+    cols = None if args.columns is None else columns(args.columns)
+    log = read_imu(args.imu, kind=args.kind, units=args.units, columns=cols,
+                   sample_rate_hz=args.sample_rate_hz, delimiter=args.delimiter)
+    f, g, segments = log_spectrum(log, nperseg=args.nperseg)
+    return f, g, log.h, segments, log.kind
+
+
+def run(args: argparse.Namespace) -> int:
+    """Rank the candidates, print the table (or ``--json``) and write the figure."""
+    from strapdown.apps.advise import advise, candidate_specs, coning_content, write_figure
+
+    f, g, h, segments, kind = _spectrum(args)
+    detected = coning_content(f, g, segments)
+    adv = advise(f, g, h, candidate_specs(kind), _ops_per_s, budget_deg_h=args.budget_deg_h,
+                 max_ops=args.max_ops, coning_detected=detected)
+    write_figure(adv, args.figure)
+    if args.json:
+        print_json(adv.to_dict())
+        return 0
+    lines = [f"{'':2s}{'spec':64s} {'drift (deg/h)':>14s} {'ops/s':>11s}"]
+    for c in adv.candidates:
+        mark = ("*" if c is adv.recommended else " ") + ("P" if str(c.spec) in adv.pareto
+                                                         else " ")
+        lines.append(f"{mark}{c.spec!s:64s} {c.predicted_drift_deg_h:14.4g} "
+                     f"{c.ops_per_s:11.4g}")
+    if not detected:
+        lines.append("no coning content: the spectrum's coning power is within the noise of "
+                     "its estimate, so every algorithm drifts alike")
+    lines.append(f"recommended   {adv.recommended.spec} ({adv.reason})")
+    lines.append("(* recommended, P Pareto front: no other candidate is both cheaper and "
+                  "better)")
+    print("\n".join(lines))
+    say(f"figure: {args.figure}")
+    return 0
