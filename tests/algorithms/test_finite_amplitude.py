@@ -101,7 +101,7 @@ def test_where_triple_terms_are_refused():
         AlgorithmSpec.parse("rotvec:N=3:coefficients=finite-amplitude:structure=realtime")
     cs = coefficient_set("finite-amplitude", 3)
     with pytest.raises(ValueError, match="triple"):
-        RotvecStream("conventional", cs, h=1e-3)
+        RotvecStream("realtime", cs, h=1e-3)
     spec = AlgorithmSpec.parse("rotvec:N=3:coefficients=finite-amplitude")
     with pytest.raises(ValueError, match="pair-only"):
         spec.propagation()
@@ -109,3 +109,18 @@ def test_where_triple_terms_are_refused():
 
     with pytest.raises(ValueError, match="triple"):
         generate("rotvec", subsamples=3, coefficients="finite-amplitude")
+
+
+@pytest.mark.parametrize("structure", list(MAKE))
+@pytest.mark.parametrize("n", [1, 3, 5])
+def test_streaming_is_the_one_shot_run_bit_for_bit(structure, n):
+    from strapdown.algorithms.structures import run_structure
+
+    cs = coefficient_set("finite-amplitude", n)
+    theta = _theta(n * 41, 30 + n)
+    whole = run_structure(structure, theta, cs, h=1e-3)
+    s = RotvecStream(structure, cs, h=1e-3)
+    rng = np.random.default_rng(n)
+    cuts = np.sort(rng.choice(np.arange(1, theta.shape[0]), size=9, replace=False))
+    parts = [s.feed(c).q for c in np.split(theta, cuts)]
+    assert np.array_equal(np.concatenate(parts), whole.q)

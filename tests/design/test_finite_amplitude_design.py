@@ -107,3 +107,13 @@ def test_series_sums_to_the_exact_response(make, n):
     exact = classical_coning_drift(alg, a, x, triples=[(*t, c) for t, c in zip(
         st.triples, d.triple_coefficients, strict=True)])
     assert summed == pytest.approx(exact, rel=1e-6)  # truncation: a⁸ ~ 5e-7 relative
+
+
+def test_design_coefficient_set_keeps_the_triple_terms():
+    from strapdown.algorithms.coning import coefficient_set
+
+    d = FA.derive_triple(FA.with_last_triples(D.interval_structure(4)))
+    cs = d.coefficient_set("mine")
+    assert cs.triples == coefficient_set("finite-amplitude", 4).triples
+    with pytest.raises(ValueError, match="no triple terms"):
+        d.algorithm()

@@ -18,11 +18,13 @@ from numpy.typing import ArrayLike, NDArray
 
 from strapdown._core.validation import as_quaternions, as_vectors, finite_array, positive
 from strapdown.algorithms import _kernels
-from strapdown.algorithms.coning import CoefficientSet
+from strapdown.algorithms.coning import CoefficientSet, triple_arrays
 from strapdown.algorithms.family import IncrementStructure
+from strapdown.algorithms.finite_amplitude import triple_terms
 from strapdown.algorithms.structures import (
     STRUCTURES,
     AttitudeSolution,
+    single_chain_coefficients,
     single_chain_table,
     stack_sets,
     startup_sets,
@@ -63,9 +65,9 @@ class RotvecStream:
                              "or single-chain")
         if not isinstance(coefficients, CoefficientSet):
             raise ValueError("coefficients must be a CoefficientSet")
-        if coefficients.triples:
-            raise ValueError(f"the streaming runner takes pair-only sets; {coefficients.name!r} "
-                             "has triple cross products (run it on the whole record)")
+        if coefficients.triples and structure == "realtime":
+            raise ValueError(f"the real-time structure runs pair-only sets; "
+                             f"{coefficients.name!r} has triple cross products")
         self.structure = structure
         self.coefficients = coefficients
         self.h = positive(h, "h (sample interval)")
@@ -77,10 +79,15 @@ class RotvecStream:
             raise ValueError(f"q0 must have shape (4,), got {q0.shape}")
         self._q0 = q0 / np.linalg.norm(q0)
         self.n = coefficients.n
+        self._triple = triple_arrays(coefficients.triples)
         if structure == "single-chain":
-            if coefficients.name not in ("table3", "none"):
-                raise ValueError("the single chain takes 'table3' (designed optimum) or 'none'")
-            self._table = single_chain_table(self.n if coefficients.name == "table3" else 1)
+            if coefficients.name not in ("table3", "none", "finite-amplitude"):
+                raise ValueError("the single chain takes 'table3' (designed optimum), "
+                                 "'finite-amplitude' or 'none'")
+            self._table = single_chain_table(self.n if coefficients.name != "none" else 1)
+            if coefficients.name == "finite-amplitude":  # the single chain's own triple set
+                self._triple = triple_arrays(triple_terms("single-chain", self.n))
+                self._steady = np.array([float(c) for c in single_chain_coefficients(self.n)])
         if structure == "realtime":
             self._ks = stack_sets(startup_sets(coefficients))
         self._buf = _EMPTY  # increments carried over
@@ -116,7 +123,11 @@ class RotvecStream:
         first = self._qhist is None
         q = np.empty((m + 1, 4))
         q[0] = self._q0 if first else self._qhist[-1]
-        if m:
+        if m and self.coefficients.triples:
+            _kernels.conventional_triple_kernel(np.ascontiguousarray(data[:m * n]),
+                                                np.ascontiguousarray(self.coefficients.matrix),
+                                                *self._triple, q[0], q)
+        elif m:
             _kernels.conventional_kernel(np.ascontiguousarray(data[:m * n]),
                                          np.ascontiguousarray(self.coefficients.matrix), q[0], q)
         self._count += m * n
@@ -131,7 +142,15 @@ class RotvecStream:
         first = self._qhist is None
         q = np.empty((x.shape[0] + 1, 4))
         q[0] = self._q0 if first else self._qhist[-1]
-        _kernels.single_chain_kernel(data, self._table, start, self._count, q)
+        if self._triple[3].size:  # finite-amplitude: plain start-up rows, then the triple kernel
+            r = max(0, min(x.shape[0], nm1 - self._count))
+            _kernels.single_chain_kernel(np.ascontiguousarray(data[:start + r]), self._table,
+                                         start, self._count, q[:r + 1])
+            if x.shape[0] > r:
+                _kernels.single_chain_triple_kernel(data, self._steady, *self._triple,
+                                                    start + r, q[r:])
+        else:
+            _kernels.single_chain_kernel(data, self._table, start, self._count, q)
         self._count += x.shape[0]
         keep = min(nm1, data.shape[0])
         self._buf = data[data.shape[0] - keep:].copy() if keep else _EMPTY

@@ -570,13 +570,19 @@ class Design:
         for (i, j), c in zip(st.pairs, self.coefficients, strict=True):
             k[i][j] += c
         mat = np.array([[float(v) for v in r] for r in k])
+        triples = tuple((m, i, j, c) for (m, i, j), c in zip(st.triples, self.triple_coefficients,
+                                                             strict=True))
         return CoefficientSet(name or f"designed-{self.target}", n, mat,
                               tuple(tuple(r) for r in k), f"derived: {st.name}, {self.target}",
-                              self.target == "coning" and self.order == 2 * n)
+                              self.target == "coning" and self.order == 2 * n, triples)
 
     def algorithm(self) -> WindowedAlgorithm:
-        """The derived algorithm in general windowed form (any structure)."""
+        """The derived algorithm in general windowed form (any structure; pair terms only:
+        a design with triple terms runs through :meth:`coefficient_set`)."""
         st = self.structure
+        if st.triples:
+            raise ValueError("the windowed form has no triple terms; use coefficient_set() "
+                             "(conventional) or the finite-amplitude sets")
         if any(s != int(s) for s in st.nodes):
             raise ValueError("nodes off the sample grid cannot run on a sample stream")
         return WindowedAlgorithm(st.input, st.update, tuple(int(s) for s in st.nodes),
