@@ -19,7 +19,8 @@ a small function that numba inlines into the loop (``inline="always"``):
    second-order Butterworth low-pass, :func:`_lowpass`) or :func:`_acc_plausible`,
    :func:`_lever_sigma` and :func:`_acc_raw_model` (the Singer (1970) manoeuvre state);
 6. the magnetometer as a heading measurement: the field rotated into the reference
-   frame with the attitude of ``mag_delay`` epochs earlier (:func:`_delayed_field`),
+   frame with the attitude of the magnetometer's delay earlier (:func:`_delayed_field`;
+   the delay fixed or estimated online, :func:`_fold_delay_samples`),
    its norm and dip low-passed and compared with a slowly learned reference
    (:func:`_mag_disturbance`, after Laidig & Seel (2023), Sec. 2.5), recovery
    (:func:`_mag_recovery`), :func:`_heading_model` and the heading update
@@ -177,7 +178,10 @@ class Params(NamedTuple):
     mc_a2: float
     mc_init_n: int
     mag_ref_k: float  #: gain of the reference's slow update per epoch
-    mag_delay: int  #: the magnetometer's delay, epochs
+    mag_delay: int  #: the magnetometer's delay, samples (fixed, or the estimator's start)
+    estimate_mag_delay: bool  #: estimate the delay online (:func:`_fold_delay_samples`)
+    mag_delay_max: int  #: the estimator's largest candidate, samples
+    mag_delay_alpha: float  #: its averaging gain per sample
 
 
 class Initial(NamedTuple):
@@ -191,10 +195,10 @@ class Initial(NamedTuple):
 class Outputs(NamedTuple):
     """The outputs, allocated by the caller with a row per sample (n): each epoch writes
     the row of its sample k — q (n, 4), gyro_bias, accel, acc_bias (n, 3), flags (n,)
-    int64, nis (n, 2) (accelerometer, heading; NaN without an update), attitude_sigma
-    (n, 3), attitude_cov (n, 3, 3) (of δθ_b), bias_var (n, 3) (the gyro bias's
-    variances) — and ``sample[e]``, epoch e's sample index; other rows are left as
-    they were."""
+    int64, nis (n, 2) (accelerometer, heading; NaN without an update), attitude_cov
+    (n, 3, 3) (of δθ_b), bias_var (n, 3) (the gyro bias's variances), mag_delay (n,)
+    int64 (the magnetometer delay in use, samples) — and ``sample[e]``, epoch e's
+    sample index; other rows are left as they were."""
 
     q: np.ndarray
     gyro_bias: np.ndarray
@@ -203,9 +207,9 @@ class Outputs(NamedTuple):
     sample: np.ndarray
     flags: np.ndarray
     nis: np.ndarray
-    attitude_sigma: np.ndarray
     attitude_cov: np.ndarray
     bias_var: np.ndarray
+    mag_delay: np.ndarray
 
 
 # ---------------------------------------------------------------- small numerics
@@ -551,20 +555,40 @@ def _propagate_covariance(P, phi, T, decay, singer, A, M):
     A[1, 2] = px + 0.5 * py * pz
     A[2, 1] = -px + 0.5 * py * pz
     nx = P.shape[0]
-    for c in range(nx):  # M = Φ P
-        for r in range(3):
-            M[r, c] = (A[r, 0] * P[0, c] + A[r, 1] * P[1, c] + A[r, 2] * P[2, c]
-                       - T * P[3 + r, c])
-        for r in range(3, nx):
-            M[r, c] = (decay if singer and 6 <= r < 9 else 1.0) * P[r, c]
-    for r in range(nx):  # (Φ P) Φᵀ, symmetric: the upper triangle, mirrored
-        for c in range(min(r + 1, 3)):
-            P[c, r] = (M[r, 0] * A[c, 0] + M[r, 1] * A[c, 1] + M[r, 2] * A[c, 2]
-                       - T * M[r, 3 + c])
-            P[r, c] = P[c, r]
-        for c in range(3, r + 1):
-            P[c, r] = (decay if singer and 6 <= c < 9 else 1.0) * M[r, c]
-            P[r, c] = P[c, r]
+    # in blocks (a: attitude, b: gyro bias, e: the rest), with Y = A P_aa − T P_ba:
+    # P_ab ← A P_ab − T P_bb, P_aa ← Y Aᵀ − T P_ab(new), P_bb unchanged; row e of the
+    # rest scaled by its decay d_e: P_ea ← d_e (P_ea Aᵀ − T P_eb), P_eb ← d_e P_eb,
+    # P_ef ← d_e d_f P_ef. M holds Y and the new P_ab first (constant-size loops).
+    for i in range(3):
+        for j in range(3):
+            M[i, j] = (A[i, 0] * P[0, j] + A[i, 1] * P[1, j] + A[i, 2] * P[2, j]
+                       - T * P[3 + i, j])
+            M[i, 3 + j] = (A[i, 0] * P[0, 3 + j] + A[i, 1] * P[1, 3 + j]
+                           + A[i, 2] * P[2, 3 + j] - T * P[3 + i, 3 + j])
+    for i in range(3):
+        for j in range(i + 1):
+            v = (M[i, 0] * A[j, 0] + M[i, 1] * A[j, 1] + M[i, 2] * A[j, 2]
+                 - T * M[i, 3 + j])
+            P[i, j] = v
+            P[j, i] = v
+        for j in range(3):
+            P[i, 3 + j] = M[i, 3 + j]
+            P[3 + j, i] = M[i, 3 + j]
+    for e in range(6, nx):
+        de = decay if singer and e < 9 else 1.0
+        for j in range(3):
+            v = de * (P[e, 0] * A[j, 0] + P[e, 1] * A[j, 1] + P[e, 2] * A[j, 2]
+                      - T * P[e, 3 + j])
+            M[e, j] = v
+        for j in range(3):
+            P[e, j] = M[e, j]
+            P[j, e] = M[e, j]
+            P[e, 3 + j] = de * P[e, 3 + j]
+            P[3 + j, e] = P[e, 3 + j]
+        for f in range(6, e + 1):
+            v = de * (decay if singer and f < 9 else 1.0) * P[e, f]
+            P[e, f] = v
+            P[f, e] = v
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -599,12 +623,13 @@ def _rest_detect(ema_n, rest_alpha, params, gm, g2, am, a2):
     for a in range(3):
         sg += max(g2[a] - gm[a] * gm[a], 0.0)
         sacc += max(a2[a] - am[a] * am[a], 0.0)
-    wm = np.sqrt(gm[0] ** 2 + gm[1] ** 2 + gm[2] ** 2)
-    amn = np.sqrt(am[0] ** 2 + am[1] ** 2 + am[2] ** 2)
+    wm2 = gm[0] ** 2 + gm[1] ** 2 + gm[2] ** 2
     settled = ema_n * rest_alpha > 1.0
-    acc_quiet = (settled and np.sqrt(sacc) < params.rest_acc
-                 and abs(amn - params.gravity) < params.rest_acc)
-    at_rest = acc_quiet and np.sqrt(sg) < params.rest_gyro and wm < 5.0 * params.rest_gyro
+    ra = params.rest_acc
+    acc_quiet = (settled and sacc < ra * ra
+                 and abs(np.sqrt(am[0] ** 2 + am[1] ** 2 + am[2] ** 2) - params.gravity) < ra)
+    rg = params.rest_gyro
+    at_rest = acc_quiet and sg < rg * rg and wm2 < 25.0 * rg * rg
     return acc_quiet, at_rest
 
 
@@ -730,10 +755,48 @@ def _acc_raw_model(params, accel, C, fk, v, dx, H, y):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
+def _fold_delay_samples(last, k, n_seen, x, mag, h, is_rate, bias, alpha, res):
+    """Stage 6, the delay estimator: fold samples last + 1 … k into ``res[d]``, the moving
+    average of the field's kinematic residual ``|Δm_j + h ω̄_{j−d} × m̄_j|²`` for each
+    candidate delay d (samples): a field constant in the reference frame turns in the
+    body frame as ``ṁ = −ω × m``, so a magnetometer d samples late matches the gyro of
+    d samples earlier best (ω̄: the bias-corrected mean rate over the interval, m̄ the
+    mean field). Returns (last, samples seen); the delay is the argmin of ``res``."""
+    dmax = res.size - 1
+    while last < k:
+        last += 1
+        if last < dmax + 2:
+            continue  # every candidate needs its gyro interval
+        n_seen += 1
+        al = max(alpha, 1.0 / n_seen)
+        dm0 = mag[last, 0] - mag[last - 1, 0]
+        dm1 = mag[last, 1] - mag[last - 1, 1]
+        dm2 = mag[last, 2] - mag[last - 1, 2]
+        m0 = 0.5 * (mag[last, 0] + mag[last - 1, 0])
+        m1 = 0.5 * (mag[last, 1] + mag[last - 1, 1])
+        m2 = 0.5 * (mag[last, 2] + mag[last - 1, 2])
+        for d in range(dmax + 1):
+            j = last - d  # the interval (j − 1, j]
+            if is_rate:
+                w0 = h * (0.5 * (x[j, 0] + x[j - 1, 0]) - bias[0])
+                w1 = h * (0.5 * (x[j, 1] + x[j - 1, 1]) - bias[1])
+                w2 = h * (0.5 * (x[j, 2] + x[j - 1, 2]) - bias[2])
+            else:
+                w0 = x[j - 1, 0] - h * bias[0]
+                w1 = x[j - 1, 1] - h * bias[1]
+                w2 = x[j - 1, 2] - h * bias[2]
+            r0 = dm0 + w1 * m2 - w2 * m1
+            r1 = dm1 + w2 * m0 - w0 * m2
+            r2 = dm2 + w0 * m1 - w1 * m0
+            res[d] += al * (r0 * r0 + r1 * r1 + r2 * r2 - res[d])
+    return last, n_seen
+
+
+@njit(cache=True, inline="always", error_model="numpy")
 def _delayed_field(ringC, j, mag, k, mn):
     """Stage 6: the field sample k in the reference frame, ``mn = C_j m_k`` with the
-    attitude ``ringC[j]`` of ``mag_delay`` epochs earlier (the magnetometer lags the
-    gyro); returns its norm."""
+    attitude ``ringC[j]`` of the magnetometer's delay earlier (it lags the gyro);
+    returns its norm."""
     for a in range(3):
         mn[a] = ringC[j, a, 0] * mag[k, 0] + ringC[j, a, 1] * mag[k, 1] + ringC[j, a, 2] * mag[k, 2]
     return np.sqrt(mn[0] ** 2 + mn[1] ** 2 + mn[2] ** 2)
@@ -748,9 +811,10 @@ def _store_dcm(ringC, j, C):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _mag_disturbance(T, rate, params, nd, ms):
+def _mag_disturbance(T, rate2, params, nd, ms):
     """Stage 6: the magnetic-disturbance state ``ms`` (indices ``M_*``) after one sample
-    whose low-passed norm and dip are ``nd`` (after Laidig & Seel (2023), Sec. 2.5).
+    whose low-passed norm and dip are ``nd``, the gyro's mean rate squared ``rate2``
+    (after Laidig & Seel (2023), Sec. 2.5).
 
     Undisturbed when norm and dip agree with the reference within the tolerances for
     ``mag_settle_s``; then the reference follows them slowly (gain ``mag_ref_k``). A new
@@ -773,7 +837,7 @@ def _mag_disturbance(T, rate, params, nd, ms):
         ms[M_UNDIST] = 0.0
         ms[M_DIST] = 1.0
     if abs(nd[0] - ms[M_CNORM]) < tol_n * ms[M_CNORM] and abs(nd[1] - ms[M_CDIP]) < tol_d:
-        if rate >= params.mag_new_min_rate:
+        if rate2 >= params.mag_new_min_rate ** 2:
             ms[M_CT] += T
         ms[M_CNORM] += kr * (nd[0] - ms[M_CNORM])
         ms[M_CDIP] += kr * (nd[1] - ms[M_CDIP])
@@ -905,8 +969,7 @@ def ekf_kernel(sensors, prop, window, params, init, out):
     is_rate, lag = prop.is_rate, prop.lag
     nx = init.P.shape[0]  # 6; 9 with the Singer state (raw model); + 3 with the acc bias
     singer = not params.acc_lowpass
-    (out_q, out_b, out_a, out_ab, out_idx, out_flags, out_nis, out_sig, out_cov,
-     out_bv) = out
+    out_q, out_b, out_a, out_ab, out_idx, out_flags, out_nis, out_cov, out_bv, out_md = out
     # the estimate: attitude, gyro bias, manoeuvre acceleration, accelerometer bias,
     # covariance, and the outputs of the last `lag` epochs (the sliding bases; with
     # lag 1 the row is q itself)
@@ -971,8 +1034,13 @@ def ekf_kernel(sensors, prop, window, params, init, out):
     Si2 = np.empty((2, 2))
     # the magnetometer: the attitudes of the last mag_delay epochs, the low-passed norm
     # and dip and their filter, the disturbance state (M_* indices)
-    n_delay = params.mag_delay + 1
+    d_max = params.mag_delay_max if params.estimate_mag_delay else params.mag_delay
+    n_delay = (d_max + prop.stride // 2) // prop.stride + 1  # an attitude per epoch
     ringC = np.empty((n_delay, 3, 3))
+    delay_res = np.zeros(d_max + 1)
+    delay = params.mag_delay  # samples
+    last_d = 0
+    n_delay_seen = 0
     _dcm(init.q, C)
     for j in range(n_delay):
         _store_dcm(ringC, j, C)
@@ -1062,14 +1130,21 @@ def ekf_kernel(sensors, prop, window, params, init, out):
         # the heading update)
         nis_mag = np.nan
         if params.use_magnetometer:
+            if params.estimate_mag_delay:
+                last_d, n_delay_seen = _fold_delay_samples(last_d, k, n_delay_seen, x, mag, h,
+                                                           is_rate, bias, params.mag_delay_alpha,
+                                                           delay_res)
+                if n_delay_seen > 0:
+                    delay = int(np.argmin(delay_res))
             _store_dcm(ringC, step % n_delay, C)
-            nb = _delayed_field(ringC, (step + 1) % n_delay, mag, k, mn)
+            nb = _delayed_field(ringC, (step - (delay + prop.stride // 2) // prop.stride)
+                                % n_delay, mag, k, mn)
             nd_raw[0] = nb
             nd_raw[1] = -np.arcsin(min(max(mn[2] / nb, -1.0), 1.0)) if nb > 0.0 else 0.0
             mc_n = _lowpass(nd_raw, mc_n, params.mc_init_n, params.mc_b0, params.mc_b1,
                             params.mc_b2, params.mc_a1, params.mc_a2, mc_s0, mc_s1, nd)
-            rate = np.sqrt(gm[0] ** 2 + gm[1] ** 2 + gm[2] ** 2)
-            dist = params.gating and _mag_disturbance(T, rate, params, nd, ms)
+            dist = params.gating and _mag_disturbance(T, gm[0] ** 2 + gm[1] ** 2 + gm[2] ** 2,
+                                                      params, nd, ms)
             horizontal = mn[0] ** 2 + mn[1] ** 2 > 1e-12 * nb * nb
             if dist:
                 flags |= F_MAG_DISTURBED
@@ -1102,11 +1177,11 @@ def ekf_kernel(sensors, prop, window, params, init, out):
             out_b[k, a] = bias[a]
             out_a[k, a] = accel[a]
             out_ab[k, a] = acc_bias[a]
-            out_sig[k, a] = np.sqrt(max(P[a, a], 0.0))
             out_bv[k, a] = P[3 + a, 3 + a]
             for c in range(3):
                 out_cov[k, a, c] = P[a, c]
         out_idx[step] = k
+        out_md[k] = delay
         out_flags[k] = flags
         out_nis[k, 0] = nis_acc
         out_nis[k, 1] = nis_mag

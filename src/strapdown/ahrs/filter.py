@@ -146,8 +146,14 @@ class AhrsConfig:
         That variance factor (CV).
     mag_delay_s : float
         Delay of the magnetometer behind the gyro, s: each field sample is rotated
-        with the attitude of that long ago (rounded to whole filter epochs). CV; see
-        :func:`estimate_mag_delay` for a measurement from a recording.
+        with the attitude of that long ago (rounded to whole filter epochs). With
+        ``estimate_mag_delay`` the estimator's starting value. Default 0.
+    estimate_mag_delay : bool
+        Estimate the delay online, causally (default on): the candidate of 0 …
+        ``mag_delay_max_s`` whose gyro best explains how the field turns in the body
+        frame (``ṁ = −ω × m``), averaged over ``mag_delay_tau_s``.
+    mag_delay_max_s, mag_delay_tau_s : float
+        Its largest candidate and averaging time, s. Defaults 0.02, 10.
     latency_s : float
         Latency of the IMU's samples behind the motion they measure (its internal
         filters' group delay), s: each output attitude is predicted that far ahead on
@@ -220,6 +226,9 @@ class AhrsConfig:
     mag_reject_s: float = 0.0
     mag_disturbed_factor: float = 8.0
     mag_delay_s: float = 0.0
+    estimate_mag_delay: bool = True
+    mag_delay_max_s: float = 0.02
+    mag_delay_tau_s: float = 10.0
     latency_s: float = 0.0
     recover_acc_s: float = 2.0
     recover_mag_s: float = 10.0
@@ -266,7 +275,8 @@ class AhrsConfig:
 
 #: AhrsConfig fields that may be negative, and those that may be zero.
 _ANY_SIGN = ("declination_deg",)
-_NON_NEGATIVE = ("lever_arm", "tilt_rate_noise", "mag_reject_s", "mag_delay_s", "latency_s")
+_NON_NEGATIVE = ("lever_arm", "tilt_rate_noise", "mag_reject_s", "mag_delay_s", "latency_s",
+                 "mag_delay_max_s")
 
 
 @dataclass(frozen=True)
@@ -309,6 +319,9 @@ class AhrsResult:
     algorithm : str
     acc_bias : ndarray (n, 3) or None
         Estimated accelerometer bias, m/s² (with ``estimate_acc_bias``).
+    mag_delay_s : ndarray (n,) or None
+        The magnetometer delay in use at each row, s (estimated online with
+        ``estimate_mag_delay``); None without a magnetometer.
     """
 
     t: np.ndarray
@@ -325,11 +338,12 @@ class AhrsResult:
     algorithm: str
     config: AhrsConfig = field(repr=False, default_factory=AhrsConfig)
     acc_bias: np.ndarray | None = None
+    mag_delay_s: np.ndarray | None = None
 
     def __post_init__(self):
         n = self.t.shape[0]
         for name in ("index", "epoch", "q", "gyro_bias", "accel", "flags", "nis",
-                     "attitude_sigma", "acc_bias"):
+                     "attitude_sigma", "acc_bias", "mag_delay_s"):
             a = getattr(self, name)
             if a is not None and a.shape[0] != n:
                 raise ValueError(f"AhrsResult.{name} has {a.shape[0]} rows, t has {n}: one "
@@ -476,11 +490,12 @@ def butterworth(tau: float, ts: float) -> tuple[float, float, float, float, floa
     return b0, 2.0 * b0, b0, 2.0 * (c * c - 1.0) / d, (1.0 - math.sqrt(2.0) * c + c * c) / d
 
 
-def _derived(cfg: AhrsConfig, ref, use_mag: bool, te: float) -> dict:
+def _derived(cfg: AhrsConfig, ref, use_mag: bool, h: float, te: float) -> dict:
     """The kernel parameters that are not config fields of the same name: the reference
     field ``ref`` (norm, dip, heading), the switches, and what depends on the epoch
     period ``te`` — the low-pass coefficients and averaging counts, the reference's
-    gain per epoch, the magnetometer delay in epochs."""
+    gain per epoch — or on the sample period ``h`` — the magnetometer delay and its
+    estimator, in samples."""
     lp = butterworth(cfg.acc_lowpass_s, te)
     mc = butterworth(cfg.mag_current_s, te)
     return {"ref_norm": ref[0], "ref_dip": ref[1], "ref_heading": ref[2],
@@ -491,17 +506,19 @@ def _derived(cfg: AhrsConfig, ref, use_mag: bool, te: float) -> dict:
             "lp_init_n": max(1, math.ceil(cfg.acc_lowpass_s / te - 1e-9)),
             "mc_init_n": max(1, math.ceil(cfg.mag_current_s / te - 1e-9)),
             "mag_ref_k": 1.0 - math.exp(-te / cfg.mag_reference_s),
-            "mag_delay": round(cfg.mag_delay_s / te)}
+            "mag_delay": round(cfg.mag_delay_s / h),
+            "mag_delay_max": max(round(cfg.mag_delay_max_s / h), round(cfg.mag_delay_s / h)),
+            "mag_delay_alpha": min(1.0, h / cfg.mag_delay_tau_s)}
 
 
-def _params(cfg: AhrsConfig, ref, use_mag: bool, te: float) -> K.Params:
+def _params(cfg: AhrsConfig, ref, use_mag: bool, h: float, te: float) -> K.Params:
     """The kernel's parameter record: the config's fields of the same name and
-    :func:`_derived`'s for the epoch period ``te``.
+    :func:`_derived`'s for the sample period ``h`` and the epoch period ``te``.
 
     Every value is converted to its field's type (float, int or bool), so the
     compiled kernel's signature — and numba's cache entry — never changes.
     """
-    derived = _derived(cfg, ref, use_mag, te)
+    derived = _derived(cfg, ref, use_mag, h, te)
     types = typing.get_type_hints(K.Params)
     return K.Params(**{f: types[f](derived[f] if f in derived else getattr(cfg, f))
                        for f in K.Params._fields})
@@ -543,14 +560,14 @@ def _run(rec, acc, mag, prop: K.Propagation, window: K.Window, params: K.Params,
     out = K.Outputs(q=np.empty((n, 4)), gyro_bias=np.empty((n, 3)), accel=np.zeros((n, 3)),
                     acc_bias=np.zeros((n, 3)), sample=np.empty(n, np.int64),
                     flags=np.zeros(n, np.int64), nis=np.empty((n, 2)),
-                    attitude_sigma=np.empty((n, 3)), attitude_cov=np.empty((n, 3, 3)),
-                    bias_var=np.empty((n, 3)))
+                    attitude_cov=np.empty((n, 3, 3)),
+                    bias_var=np.empty((n, 3)), mag_delay=np.zeros(n, np.int64))
     out.q[0] = init.q
     out.gyro_bias[0] = init.gyro_bias
     out.nis[0] = np.nan
-    out.attitude_sigma[0] = np.sqrt(np.diag(init.P)[:3])
     out.attitude_cov[0] = init.P[:3, :3]
     out.bias_var[0] = np.diag(init.P)[3:6]
+    out.mag_delay[0] = params.mag_delay
     k = K.ekf_kernel(K.Sensors(np.ascontiguousarray(x), acc, mag, float(h)), prop, window,
                      params, init, out)
     return out, k
@@ -588,11 +605,12 @@ def _result(rec, out: K.Outputs, k: int, frame: str, have_mag: bool, algorithm: 
     q, bias = out.q, out.gyro_bias
     if held.size:
         last = np.maximum.accumulate(np.where(epoch, rows, 0))  # the last epoch row (or 0)
-        for a in (bias, out.accel, out.acc_bias, out.attitude_sigma, out.attitude_cov,
-                  out.bias_var):
+        for a in (bias, out.accel, out.acc_bias, out.attitude_cov, out.bias_var,
+                  out.mag_delay):
             a[held] = a[last[held]]
         out.nis[held] = np.nan
         _fill_between_epochs(rec, q, bias, last)
+    sigma = np.sqrt(np.maximum(np.diagonal(out.attitude_cov, axis1=1, axis2=2), 0.0))
     if cfg.latency_s > 0:  # predict each attitude over the sensor's latency (causal)
         from strapdown.rotation.quaternion import quat_from_rotvec
 
@@ -600,8 +618,9 @@ def _result(rec, out: K.Outputs, k: int, frame: str, have_mag: bool, algorithm: 
     if frame == "NED":
         q = quat_multiply(Q_NED_ENU, q)
     return AhrsResult(rec.t, rows, epoch, q, frame, have_mag, bias, out.accel, out.flags,
-                      out.nis, out.attitude_sigma, algorithm, cfg,
-                      out.acc_bias if cfg.estimate_acc_bias else None)
+                      out.nis, sigma, algorithm, cfg,
+                      out.acc_bias if cfg.estimate_acc_bias else None,
+                      out.mag_delay * rec.td if have_mag else None)
 
 
 def ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
@@ -654,6 +673,6 @@ def ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
     b0 = np.zeros(3) if gyro_bias0 is None else _check("gyro_bias0", [gyro_bias0], 1)[0]
     prop, window = _propagation(_algorithm(algorithm))
     init = K.Initial(q_init, b0, _initial_covariance(cfg))
-    out, k = _run(rec, acc, mag, prop, window, _params(cfg, ref, have_mag, prop.stride * rec.td),
-                  init)
+    params = _params(cfg, ref, have_mag, rec.td, prop.stride * rec.td)
+    out, k = _run(rec, acc, mag, prop, window, params, init)
     return _result(rec, out, k, frame, have_mag, algorithm, cfg)
