@@ -84,10 +84,9 @@ def as_times(t: ArrayLike, name: str = "t", *, min_len: int = 1) -> NDArray[np.f
 def first_bad_step(d: NDArray[np.float64]) -> tuple[int, str] | None:
     """First non-positive time step in ``d = diff(t)``: ``(i, "duplicated" | "non-monotonic")``,
     so that ``t[i + 1]`` does not exceed ``t[i]``; ``None`` if ``t`` strictly increases."""
-    bad = d <= 0
-    if not np.any(bad):
+    if d.size == 0 or d.min() > 0:  # one pass, no temporary: the common case
         return None
-    i = int(np.argmax(bad))
+    i = int(np.argmax(d <= 0))
     return i, "duplicated" if d[i] == 0 else "non-monotonic"
 
 

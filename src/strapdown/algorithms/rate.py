@@ -129,8 +129,9 @@ class RateRecord:
 
 
 def _checked_arrays(stamps: ArrayLike, omega: ArrayLike, min_samples: int
-                    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """``(t, omega)`` as float64 after the shape, finiteness, length and monotonicity checks."""
+                    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """``(t, omega, diff(t))`` as float64 after the shape, finiteness, length and
+    monotonicity checks."""
     t = np.asarray(stamps, dtype=np.float64)
     w = np.asarray(omega, dtype=np.float64)
     if t.ndim != 1:
@@ -138,19 +139,31 @@ def _checked_arrays(stamps: ArrayLike, omega: ArrayLike, min_samples: int
     if w.shape != (t.size, 3):
         raise ValueError(f"rates must have shape ({t.size}, 3) to match t, got {w.shape}")
     for name, arr in (("t", t), ("rates", w)):
-        bad = ~np.isfinite(arr)
-        if np.any(bad):
-            row = int(np.argwhere(bad)[0][0])
-            raise ValueError(f"{name} has NaN or infinity at row {row}")
+        # a finite sum means every value is finite (one pass, no temporary); a sum that
+        # overflowed or met NaN/inf is checked element by element to name the row
+        if not np.isfinite(np.add.reduce(arr, axis=None)):
+            bad = ~np.isfinite(arr)
+            if np.any(bad):
+                row = int(np.argwhere(bad)[0][0])
+                raise ValueError(f"{name} has NaN or infinity at row {row}")
     if t.size < min_samples:
         raise ValueError(f"the record has {t.size} samples; this algorithm needs at least "
                          f"{min_samples}")
-    fault = first_bad_step(np.diff(t))
+    d = np.diff(t)
+    fault = first_bad_step(d)
     if fault is not None:
         i, kind = fault
         raise ValueError(f"{kind} time stamp at row {i + 1}: t[{i + 1}] = {t[i + 1]!r} after "
                          f"t[{i}] = {t[i]!r}")
-    return t, w
+    return t, w, d
+
+
+def _uniform(d: NDArray[np.float64], td: float) -> bool:
+    """Every interval within :data:`UNIFORM_TOLERANCE` of ``td``: the same test as
+    ``all(|d − td| ≤ tol·td)``, on the extremes (rounding of ``d − td`` is monotonic in
+    ``d``), so two passes and no temporaries."""
+    tol = UNIFORM_TOLERANCE * td
+    return bool(d.max() - td <= tol and td - d.min() <= tol)
 
 
 def _grid_fit(t: NDArray[np.float64], td: float | None) -> tuple[float, float]:
@@ -236,14 +249,13 @@ def check_rate_record(t: ArrayLike, omega: ArrayLike, *, min_samples: int = 2,
     jitter_tolerance : float
         Largest deviation of a stamp from the uniform grid, in periods.
     """
-    ts, w = _checked_arrays(t, omega, min_samples)
-    d = np.diff(ts)
+    ts, w, d = _checked_arrays(t, omega, min_samples)
     if td is None:
         td_end = float((ts[-1] - ts[0]) / (ts.size - 1))  # nominal interval: O(n), no sort
-        if not np.any(np.abs(d - td_end) > UNIFORM_TOLERANCE * td_end):
+        if _uniform(d, td_end):
             return RateRecord(ts, w, td_end)
         med = float(np.median(d))
-        if not np.any(np.abs(d - med) > UNIFORM_TOLERANCE * med):
+        if _uniform(d, med):
             return RateRecord(ts, w, med)
     elif not td > 0 or not np.isfinite(td):
         raise ValueError(f"the sample period must be positive and finite, got {td!r}")
