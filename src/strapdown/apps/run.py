@@ -237,7 +237,8 @@ def run_log(imu: str | os.PathLike[str], out: str | os.PathLike[str], *, kind: I
         warnings.simplefilter("always")
         with output_with_sidecar(out_path) as paired:
             if spec.input_kind == "rate":
-                res = _run_rates(imu_path, paired.path, read, spec, angles, q0, split, resample)
+                res = _run_rates(imu_path, paired.path, read, spec, angles, q0, split, resample,
+                                 progress)
             else:
                 res = _run_increments(imu_path, paired.path, read, spec, angles, q0, split,
                                       progress)
@@ -347,8 +348,11 @@ def _run_increments(imu: Path, tmp: Path, read: dict[str, Any], spec: AlgorithmS
 
 def _run_rates(imu: Path, tmp: Path, read: dict[str, Any], spec: AlgorithmSpec,
                angles: AngleOutput, q0: ArrayLike | None, split: bool,
-               resample: bool) -> dict[str, Any]:
-    """Run the rate algorithm over each gap-free record and write ``tmp`` (see run_log)."""
+               resample: bool, progress: bool = False) -> dict[str, Any]:
+    """Run the rate algorithm over each gap-free record and write ``tmp`` (see run_log).
+
+    The progress bar advances by each record's samples as its run completes (a rate
+    algorithm runs a whole record in one compiled call)."""
     from strapdown.io import write_attitude
 
     log = read_imu(imu, **read)
@@ -356,12 +360,15 @@ def _run_rates(imu: Path, tmp: Path, read: dict[str, Any], spec: AlgorithmSpec,
                               resample=resample)
     ts, qs, segs = [], [], []
     q_last = q0
-    for k, rec in enumerate(recs):
-        sol = spec.run_rates(rec.t, rec.omega, q0=q_last)
-        ts.append(sol.t)
-        qs.append(sol.q)
-        segs.append(np.full(sol.t.size, float(k)))
-        q_last = sol.q[-1]
+    with tqdm(total=int(log.t.size), disable=not progress, unit="sample", unit_scale=True,
+              file=sys.stderr) as bar:
+        for k, rec in enumerate(recs):
+            sol = spec.run_rates(rec.t, rec.omega, q0=q_last)
+            ts.append(sol.t)
+            qs.append(sol.q)
+            segs.append(np.full(sol.t.size, float(k)))
+            q_last = sol.q[-1]
+            bar.update(int(rec.t.size))
     t, q = np.concatenate(ts), np.concatenate(qs)
     check_finite(f"the {spec} attitude", t, q)
     extra = _angles(q, angles)
