@@ -83,7 +83,9 @@ def compare_motion(base: EvaluationConfig, specs: Iterable[str], out: str | os.P
     if not specs:
         raise InputError("give at least one algorithm spec")
     runs, notes = [], []
-    for spec in specs:
+    for k, spec in enumerate(specs, start=1):
+        if progress is not None:
+            progress(f"[{k}/{len(specs)}] {spec}")
         cfg = dataclasses.replace(base, **parse_spec(spec))
         ev = evaluate(cfg)
         d = ev.to_dict()
