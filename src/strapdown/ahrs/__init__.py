@@ -1,9 +1,11 @@
 """The AHRS: a multiplicative error-state EKF propagated by any of the library's attitude
-algorithms (:mod:`strapdown.ahrs.filter`), compiled as one loop (:mod:`strapdown.ahrs._kernel`);
-:class:`MeasurementFlag` says what each output did with its measurements.
+algorithms (:mod:`strapdown.ahrs.filter`), compiled as one loop (:mod:`strapdown.ahrs._kernel`):
+:func:`ekf` (causal, real time) and :func:`offline_ekf` (forward and backward, acausal:
+post-processing); :class:`MeasurementFlag` says what each output did with its measurements.
 """
 
-from strapdown.ahrs.filter import AhrsConfig, AhrsResult, attitude_from_acc_mag, ekf
+from strapdown.ahrs.filter import AhrsConfig, AhrsResult, attitude_from_acc_mag, ekf, offline_ekf
 from strapdown.ahrs.flags import MeasurementFlag
 
-__all__ = ["AhrsConfig", "AhrsResult", "MeasurementFlag", "attitude_from_acc_mag", "ekf"]
+__all__ = ["AhrsConfig", "AhrsResult", "MeasurementFlag", "attitude_from_acc_mag", "ekf",
+           "offline_ekf"]

@@ -56,7 +56,8 @@ from strapdown.ahrs import _kernel as K
 from strapdown.ahrs.flags import MeasurementFlag
 from strapdown.rotation.quaternion import quat_multiply
 
-__all__ = ["AhrsConfig", "AhrsResult", "attitude_from_acc_mag", "ekf"]
+__all__ = ["AhrsConfig", "AhrsResult", "attitude_from_acc_mag", "butterworth", "ekf",
+           "offline_ekf"]
 
 G = 9.80665
 #: q_NED_ENU: rotation by π about (1, 1, 0)/√2 (swaps x and y, flips z).
@@ -322,6 +323,8 @@ class AhrsResult:
     mag_delay_s : ndarray (n,) or None
         The magnetometer delay in use at each row, s (estimated online with
         ``estimate_mag_delay``); None without a magnetometer.
+    smoothed : bool
+        True for :func:`offline_ekf`'s output: acausal, every row uses the whole record.
     """
 
     t: np.ndarray
@@ -339,6 +342,7 @@ class AhrsResult:
     config: AhrsConfig = field(repr=False, default_factory=AhrsConfig)
     acc_bias: np.ndarray | None = None
     mag_delay_s: np.ndarray | None = None
+    smoothed: bool = False
 
     def __post_init__(self):
         n = self.t.shape[0]
@@ -591,25 +595,29 @@ def _fill_between_epochs(rec, q, bias, last):
         q[i] = quat_multiply(q[i - 1], quat_from_rotvec(phi))
 
 
-def _result(rec, out: K.Outputs, k: int, frame: str, have_mag: bool, algorithm: str,
-            cfg: AhrsConfig) -> AhrsResult:
-    """One row per sample (see :class:`AhrsResult`) from the kernel's per-sample outputs:
-    rows that are neither row 0 nor an epoch get the last epoch's bias and covariance
-    and the attitude propagated from it (:func:`_fill_between_epochs`), flags 0 and no
-    NIS; the attitudes are then predicted over ``latency_s`` when it is set."""
+def _fill(rec, out: K.Outputs, k: int) -> np.ndarray:
+    """Complete the kernel's per-sample outputs in place: rows that are neither row 0 nor
+    an epoch get the last epoch's bias and covariance and the attitude propagated from
+    it (:func:`_fill_between_epochs`), flags 0 and no NIS. Returns the epoch mask."""
     n = rec.t.size
     epoch = np.zeros(n, bool)
     epoch[out.sample[:k]] = True
     held = np.flatnonzero(~epoch[1:]) + 1  # rows that are neither epochs nor row 0
-    rows = np.arange(n)
-    q, bias = out.q, out.gyro_bias
     if held.size:
-        last = np.maximum.accumulate(np.where(epoch, rows, 0))  # the last epoch row (or 0)
-        for a in (bias, out.accel, out.acc_bias, out.attitude_cov, out.bias_var,
+        last = np.maximum.accumulate(np.where(epoch, np.arange(n), 0))  # last epoch row
+        for a in (out.gyro_bias, out.accel, out.acc_bias, out.attitude_cov, out.bias_var,
                   out.mag_delay):
             a[held] = a[last[held]]
         out.nis[held] = np.nan
-        _fill_between_epochs(rec, q, bias, last)
+        _fill_between_epochs(rec, out.q, out.gyro_bias, last)
+    return epoch
+
+
+def _result(rec, out: K.Outputs, epoch, frame: str, have_mag: bool, algorithm: str,
+            cfg: AhrsConfig, smoothed: bool = False) -> AhrsResult:
+    """The :class:`AhrsResult` of completed per-sample outputs (:func:`_fill`): the
+    attitudes predicted over ``latency_s`` when it is set, then turned into ``frame``."""
+    q, bias = out.q, out.gyro_bias
     sigma = np.sqrt(np.maximum(np.diagonal(out.attitude_cov, axis1=1, axis2=2), 0.0))
     if cfg.latency_s > 0:  # predict each attitude over the sensor's latency (causal)
         from strapdown.rotation.quaternion import quat_from_rotvec
@@ -617,10 +625,31 @@ def _result(rec, out: K.Outputs, k: int, frame: str, have_mag: bool, algorithm: 
         q = quat_multiply(q, quat_from_rotvec((rec.omega - bias) * cfg.latency_s))
     if frame == "NED":
         q = quat_multiply(Q_NED_ENU, q)
-    return AhrsResult(rec.t, rows, epoch, q, frame, have_mag, bias, out.accel, out.flags,
-                      out.nis, sigma, algorithm, cfg,
+    return AhrsResult(rec.t, np.arange(rec.t.size), epoch, q, frame, have_mag, bias,
+                      out.accel, out.flags, out.nis, sigma, algorithm, cfg,
                       out.acc_bias if cfg.estimate_acc_bias else None,
-                      out.mag_delay * rec.td if have_mag else None)
+                      out.mag_delay * rec.td if have_mag else None, smoothed)
+
+
+def _setup(t, gyro, acc, mag, cfg: AhrsConfig, q0, gyro_bias0, mag_reference, frame):
+    """Validated record and initial state: (rec, acc, mag, have_mag, q_init (ENU), b0,
+    reference field (norm, dip, heading))."""
+    rec, acc, mag, have_mag = _validate(t, gyro, acc, mag, cfg, frame)
+    q_init, m0 = _initial_attitude(rec, acc, mag, have_mag, cfg, q0, frame)
+    ref = (_reference_field(rec, mag, q_init, m0, q0, mag_reference, cfg) if have_mag
+           else (0.0, 0.0, 0.0))
+    b0 = np.zeros(3) if gyro_bias0 is None else _check("gyro_bias0", [gyro_bias0], 1)[0]
+    return rec, acc, mag, have_mag, q_init, b0, ref
+
+
+def _filter(rec, acc, mag, have_mag: bool, cfg: AhrsConfig, algorithm: str, q_init, b0,
+            ref):
+    """One causal pass: the completed per-sample outputs (ENU) and the epoch mask."""
+    prop, window = _propagation(_algorithm(algorithm))
+    init = K.Initial(q_init, b0, _initial_covariance(cfg))
+    params = _params(cfg, ref, have_mag, rec.td, prop.stride * rec.td)
+    out, k = _run(rec, acc, mag, prop, window, params, init)
+    return out, _fill(rec, out, k)
 
 
 def ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
@@ -666,13 +695,77 @@ def ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
         On invalid input, naming the problem.
     """
     cfg = config or AhrsConfig()
-    rec, acc, mag, have_mag = _validate(t, gyro, acc, mag, cfg, frame)
-    q_init, m0 = _initial_attitude(rec, acc, mag, have_mag, cfg, q0, frame)
-    ref = (_reference_field(rec, mag, q_init, m0, q0, mag_reference, cfg) if have_mag
-           else (0.0, 0.0, 0.0))
-    b0 = np.zeros(3) if gyro_bias0 is None else _check("gyro_bias0", [gyro_bias0], 1)[0]
-    prop, window = _propagation(_algorithm(algorithm))
-    init = K.Initial(q_init, b0, _initial_covariance(cfg))
-    params = _params(cfg, ref, have_mag, rec.td, prop.stride * rec.td)
-    out, k = _run(rec, acc, mag, prop, window, params, init)
-    return _result(rec, out, k, frame, have_mag, algorithm, cfg)
+    rec, acc, mag, have_mag, q_init, b0, ref = _setup(t, gyro, acc, mag, cfg, q0, gyro_bias0,
+                                                       mag_reference, frame)
+    out, epoch = _filter(rec, acc, mag, have_mag, cfg, algorithm, q_init, b0, ref)
+    return _result(rec, out, epoch, frame, have_mag, algorithm, cfg)
+
+
+def _backward(rec, acc, mag, have_mag: bool, cfg: AhrsConfig, algorithm: str, fwd, ref):
+    """The same filter over the time-reversed record (gyro negated), started from the
+    forward pass's last attitude and bias and with its reference field; the
+    magnetometer, which leads in reversed time, advanced by the forward pass's median
+    delay. Returns its completed outputs in forward sample order."""
+    from dataclasses import replace
+
+    n = rec.t.size
+    d = int(np.median(fwd.mag_delay)) if have_mag else 0
+    mag_b = np.concatenate([mag[d:], np.repeat(mag[-1:], d, axis=0)])[::-1] if d else mag[::-1]
+    rec_b = replace(rec, omega=np.ascontiguousarray(-rec.omega[::-1]))
+    cfg_b = replace(cfg, estimate_mag_delay=False, mag_delay_s=0.0)
+    out, epoch = _filter(rec_b, np.ascontiguousarray(acc[::-1]), np.ascontiguousarray(mag_b),
+                         have_mag, cfg_b, algorithm, fwd.q[-1], -fwd.gyro_bias[-1], ref)
+    rev = np.arange(n)[::-1]
+    for f in ("q", "gyro_bias", "accel", "acc_bias", "flags", "nis", "attitude_cov",
+              "bias_var"):
+        getattr(out, f)[:] = getattr(out, f)[rev]
+    out.gyro_bias[:] *= -1.0
+    return out, epoch[rev]
+
+
+def _combine(fwd, bwd) -> None:
+    """Fraser–Potter two-filter combination, in place on ``fwd``: per sample, the
+    attitude ``q_f ⊗ exp(G δ)`` with ``δ = log(q_f* ⊗ q_b)`` (body frame) and
+    ``G = P_f (P_f + P_b)⁻¹``, its covariance ``P_f − G P_f``; the gyro bias weighted
+    by the inverse variances."""
+    from strapdown.rotation.quaternion import quat_conjugate, quat_from_rotvec, rotvec_from_quat
+
+    dq = quat_multiply(quat_conjugate(fwd.q), bwd.q)
+    delta = rotvec_from_quat(dq * np.where(dq[:, :1] < 0, -1.0, 1.0))
+    pf, pb = fwd.attitude_cov, bwd.attitude_cov
+    g = np.linalg.solve(pf + pb, pf).transpose(0, 2, 1)  # P_f (P_f + P_b)⁻¹ (symmetric P)
+    fwd.q[:] = quat_multiply(fwd.q, quat_from_rotvec(np.einsum("nij,nj->ni", g, delta)))
+    fwd.attitude_cov[:] = pf - g @ pf
+    wf, wb = 1.0 / fwd.bias_var, 1.0 / bwd.bias_var
+    fwd.gyro_bias[:] = (wf * fwd.gyro_bias + wb * bwd.gyro_bias) / (wf + wb)
+    fwd.bias_var[:] = 1.0 / (wf + wb)
+
+
+def offline_ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
+                config: AhrsConfig | None = None, q0=None, gyro_bias0=None,
+                mag_reference=None, frame: str = "ENU") -> AhrsResult:
+    """The AHRS for post-processing (acausal): :func:`ekf` run forward, then backward.
+
+    Every estimate uses the whole record, so this is not a real-time filter. The
+    forward pass is :func:`ekf`; the backward pass is the same filter over the
+    time-reversed record (gyro negated), started from the forward pass's last
+    attitude and bias, with its reference field and (advanced by it) its estimated
+    magnetometer delay; the two are combined sample by sample by the two-filter
+    (Fraser–Potter) rule, each weighted by its attitude covariance — so the
+    low-pass lag of one pass cancels the lead of the other, and the first seconds,
+    where the forward filter is still converging, get the backward estimate. Arguments
+    as for :func:`ekf`; the result has ``smoothed`` set, its flags, NIS and
+    manoeuvre acceleration are the forward pass's.
+
+    Raises
+    ------
+    ValueError
+        On invalid input, naming the problem.
+    """
+    cfg = config or AhrsConfig()
+    rec, acc, mag, have_mag, q_init, b0, ref = _setup(t, gyro, acc, mag, cfg, q0, gyro_bias0,
+                                                       mag_reference, frame)
+    fwd, epoch = _filter(rec, acc, mag, have_mag, cfg, algorithm, q_init, b0, ref)
+    bwd, _ = _backward(rec, acc, mag, have_mag, cfg, algorithm, fwd, ref)
+    _combine(fwd, bwd)
+    return _result(rec, fwd, epoch, frame, have_mag, algorithm, cfg, smoothed=True)

@@ -40,7 +40,7 @@ from typing import Any
 import numpy as np
 
 from strapdown._core.errors import InputError, shown
-from strapdown.ahrs import AhrsConfig, AhrsResult, MeasurementFlag, ekf
+from strapdown.ahrs import AhrsConfig, AhrsResult, MeasurementFlag, ekf, offline_ekf
 from strapdown.algorithms.rate import resample_uniform
 from strapdown.apps._logs import output_with_sidecar, rate_records, unit_action
 from strapdown.io import check_rows, csv_columns, warn_implausible_rate, write_attitude
@@ -229,8 +229,9 @@ def _merge(parts: list[AhrsResult], starts: list[int]) -> AhrsResult:
 
 
 def _filter(imu: Path, log: AhrsLog, algorithm: str, frame: str, config: AhrsConfig | None,
-            split: bool, resample: bool):
-    """The filter over each gap-free segment; ``(result, segment per output, time base)``."""
+            split: bool, resample: bool, offline: bool = False):
+    """The filter (``offline``: :func:`~strapdown.ahrs.offline_ekf`, acausal) over each
+    gap-free segment; ``(result, segment per output, time base)``."""
     glog = ImuLog(log.t, log.gyro, "rate", float(np.median(np.diff(log.t))), log.gaps, [],
                   "rad/s", log.nominal_period)
     recs, base = rate_records(imu, glog, split=split, min_samples=4, resample=resample)
@@ -242,8 +243,8 @@ def _filter(imu: Path, log: AhrsLog, algorithm: str, frame: str, config: AhrsCon
         if rec.stamps is not None and rec.resampled:
             acc = resample_uniform(rec.stamps, acc, rec.t)
             mag = None if mag is None else resample_uniform(rec.stamps, mag, rec.t)
-        r = ekf(rec.t, rec.omega, acc, mag, algorithm=algorithm, config=config, frame=frame,
-                q0=q0, gyro_bias0=b0)
+        r = (offline_ekf if offline else ekf)(rec.t, rec.omega, acc, mag, algorithm=algorithm,
+                                              config=config, frame=frame, q0=q0, gyro_bias0=b0)
         _check_output(r, log.gyro_units)
         parts.append(r)
         seg.append(np.full(r.t.size, float(k)))
@@ -256,9 +257,13 @@ def run_ahrs(imu, out, *, algorithm: str = "rate-single", frame: str = "ENU",
              acc_units: str | None = None, columns=None, use_magnetometer: bool = True,
              sample_rate_hz: float | None = None, on_gap: str = "report",
              gap_tolerance: float = 1.5, resample: bool = False,
-             accept_unit_warning: bool = False,
-             delimiter: str | None = None) -> tuple[AhrsResult, dict[str, Any]]:
+             accept_unit_warning: bool = False, delimiter: str | None = None,
+             offline: bool = False) -> tuple[AhrsResult, dict[str, Any]]:
     """Filter a recording and write the attitude, biases and metadata atomically.
+
+    ``offline``: post-processing with :func:`~strapdown.ahrs.offline_ekf` — the filter run
+    forward and backward and the two combined, acausal (every estimate uses the whole
+    recording); the metadata's ``mode`` says which.
 
     ``on_gap``: ``"split"`` filters each gap-free segment from the previous one's last
     attitude and bias (covariance reset; the motion during the gap is not observed);
@@ -284,7 +289,7 @@ def run_ahrs(imu, out, *, algorithm: str = "rate-single", frame: str = "ENU",
             raise InputError(f"{imu}: gap of {log.t[r - 1] - log.t[r - 2]:.6g} s before data "
                              f"row {r}")
         res, seg, base = _filter(imu, log, algorithm, frame, config, on_gap == "split",
-                                 resample)
+                                 resample, offline)
         extra = {"bias_x": res.gyro_bias[:, 0], "bias_y": res.gyro_bias[:, 1],
                  "bias_z": res.gyro_bias[:, 2]}
         if on_gap == "split":
@@ -306,6 +311,8 @@ def _metadata(imu: Path, log: AhrsLog, res: AhrsResult, algorithm: str, frame: s
         "heading": ("magnetic" if res.config.declination_deg == 0 else "true")
         if res.heading_observed else "not observed (no magnetometer): gyro integral from yaw 0",
         "algorithm": algorithm, "samples": int(log.t.size), "outputs": int(res.t.size),
+        "mode": ("offline (acausal: forward and backward passes combined)" if res.smoothed
+                 else "causal (real-time filter)"),
         "accelerometer_used": res.fraction(MeasurementFlag.ACC_USED),
         "magnetometer_used": (res.fraction(MeasurementFlag.MAG_USED) if res.heading_observed
                               else 0.0),

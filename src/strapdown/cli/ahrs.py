@@ -48,6 +48,10 @@ def _arguments(p: argparse.ArgumentParser) -> None:
                    "stamps (default: from the stamps)")
     input_args(p)
     log_check_args(p, saturation=False)
+    p.add_argument("--offline", action="store_true",
+                   help="post-processing: run the filter forward and backward and combine the "
+                   "two (acausal: every estimate uses the whole recording; not a real-time "
+                   "filter)")
     p.add_argument("--no-mag", action="store_true", help="ignore the magnetometer")
     p.add_argument("--no-gating", action="store_true",
                    help="accept every measurement (no innovation gating or disturbance checks)")
@@ -68,7 +72,7 @@ def run(args: argparse.Namespace) -> int:
                          use_magnetometer=not args.no_mag, sample_rate_hz=args.sample_rate_hz,
                          on_gap=args.on_gap, gap_tolerance=args.gap_tolerance,
                          resample=args.resample, accept_unit_warning=args.accept_unit_warning,
-                         delimiter=args.delimiter)
+                         delimiter=args.delimiter, offline=args.offline)
     for w in meta["warnings"]:
         say(f"warning: {w}")
     if meta["gaps"]["count"]:
@@ -76,7 +80,8 @@ def run(args: argparse.Namespace) -> int:
             f"{meta['gaps']['first_rows'][0]}")
     if not res.heading_observed:
         say("warning: no magnetometer: heading is not observed (gyro integral from yaw 0)")
-    print(f"wrote {args.out} ({meta['outputs']} attitudes, q_n_b with n = {args.frame}; "
+    print(f"wrote {args.out} ({meta['outputs']} attitudes, {meta['mode'].split(' ')[0]}, "
+          f"q_n_b with n = {args.frame}; "
           f"accelerometer used {meta['accelerometer_used']:.0%}, magnetometer "
           f"{meta['magnetometer_used']:.0%}; {meta['time_base']}) and {args.out}.meta.json")
     return 0
