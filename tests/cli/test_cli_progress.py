@@ -33,14 +33,13 @@ def fake_benchmark(monkeypatch):
 
     given = []
 
-    def benchmark(directory, out, *, algorithm, progress=None):
+    def benchmark(directory, out, *, algorithm, heading_offset_removed, progress=None):
         given.append(progress)
         if progress is not None:
             progress("01_trial: strapdown-ekf")
         return {}
 
     monkeypatch.setattr(ahrs_benchmark, "benchmark", benchmark)
-    monkeypatch.setattr(ahrs_benchmark, "mean_total", lambda res, f: float("nan"))
     return given
 
 
