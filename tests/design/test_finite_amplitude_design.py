@@ -117,3 +117,74 @@ def test_design_coefficient_set_keeps_the_triple_terms():
     assert cs.triples == coefficient_set("finite-amplitude", 4).triples
     with pytest.raises(ValueError, match="no triple terms"):
         d.algorithm()
+
+
+def test_spin_series_is_the_exact_spin_response():
+
+    from strapdown.algorithms.spec import AlgorithmSpec
+    from strapdown.analysis.frequency_response import classical_coning_drift
+
+    for s in (F(3), F(1, 2), F(1)):
+        ser = FA.drift_series(D.interval_structure(3), TABLE3[3], spin_ratio=s, x_order=14,
+                              a_order=4)
+        a, x = 1e-3, 0.02
+        summed = sum(float(v) * a**p * x**q for p, r in ser.items() for q, v in enumerate(r))
+        exact = classical_coning_drift(AlgorithmSpec.parse("rotvec:N=3"), a, x,
+                                       spin_ratio=float(s), digits=60)
+        assert summed == pytest.approx(exact, rel=1e-9, abs=1e-40)
+    # spin spoils Table 3's order: a²Ω(Ωh)⁴ at σ = 3
+    assert FA.drift_series(D.interval_structure(3), TABLE3[3], spin_ratio=3, x_order=6,
+                           a_order=2)[2][4] == F(-12, 5)
+
+
+def test_spin_robust_design_cancels_the_x4_term_at_every_ratio():
+    d = FA.derive_spin_robust(FA.with_last_triples(D.interval_structure(3)), amplitude=False)
+    assert d.triple_coefficients == (F(51, 40), F(-39, 40))
+    for s in (F(1, 3), F(2), F(7), F(23, 2)):  # ratios the interpolation never saw
+        row = FA.drift_series(d.structure, d.coefficients, d.triple_coefficients,
+                              spin_ratio=s, x_order=6, a_order=2)[2]
+        assert row[:5] == (0,) * 5 and row[6] != 0
+    with pytest.raises(ValueError, match="cannot meet every condition"):
+        FA.derive_spin_robust(FA.with_last_triples(D.interval_structure(3)))
+    both = FA.derive_spin_robust(FA.with_triples_to_last(D.interval_structure(3)))
+    assert [(p, q) for p, q, _ in both.amplitude_law] == [(2, 6), (4, 8), (6, 6)]
+
+
+def test_spin_robust_set_in_arbitrary_precision_beats_table3_and_table7():
+    import math
+
+    import numpy as np
+
+    from strapdown.algorithms.coning import coefficient_set
+    from strapdown.algorithms.precision import run_mp
+    from strapdown.analysis.accuracy import chain_drift_rate
+    from strapdown.analysis.frequency_response import classical_coning_drift, table7_window
+    from strapdown.truth.motions import SpinConing
+
+    d = FA.derive_spin_robust(FA.with_triples_to_last(D.interval_structure(3)))
+    cs = d.coefficient_set("spin-robust")
+    a, spp, ratio = math.radians(2.0), 120, 10
+    motion = SpinConing(a, 2 * math.pi, 2 * math.pi * ratio)
+
+    def measured(c):
+        s = run_mp(motion, c, structure="conventional", h=1 / spp, samples=2 * spp, digits=40)
+        return float(np.mean([r.rate for r in chain_drift_rate(s.t, s.err[:, 0], s.chain,
+                                                              period=1.0)]))
+
+    got = measured(cs)
+    x = 2 * math.pi / spp
+    assert got == pytest.approx(classical_coning_drift(
+        coefficient_window(cs), a, x, cone_rate=2 * math.pi, spin_ratio=ratio), rel=1e-8)
+    table3 = measured(coefficient_set("table3", 3))
+    table7 = classical_coning_drift(table7_window(), a, x, cone_rate=2 * math.pi,
+                                    spin_ratio=ratio)
+    assert abs(got) * 20 < min(abs(table3), abs(table7))
+
+
+def coefficient_window(cs):
+    from strapdown.analysis.frequency_response import UpdateWindow
+
+    n = cs.n
+    pairs = tuple((i, j, cs.exact[i][j]) for i in range(n) for j in range(i + 1, n)
+                  if cs.exact[i][j])
+    return UpdateWindow("increment", n, tuple(range(n)), (F(1),) * n, pairs, cs.triples)

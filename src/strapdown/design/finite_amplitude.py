@@ -46,7 +46,8 @@ from gmpy2 import mpq
 
 from strapdown.design.designer import Design, Structure, derive
 
-__all__ = ["A_ORDER", "derive_triple", "drift_series", "leading_terms", "with_last_triples"]
+__all__ = ["A_ORDER", "derive_spin_robust", "derive_triple", "drift_series", "leading_terms",
+           "with_last_triples", "with_triples_to_last"]
 
 #: Highest power of ``a`` carried by :func:`drift_series`.
 A_ORDER = 6
@@ -154,6 +155,15 @@ class _Bivariate:
             z[0][k] = mpq((-1) ** (k // 2)) * c**k / factorial(k)
         return z
 
+    def trig_diff_x(self, nu, n, cosine: bool) -> _Series:
+        """``(cos ν(n+1)x − cos νnx)/ν`` (or the sines), a polynomial in ν: finite at ν = 0."""
+        z = self.zero()
+        nu, n = mpq(nu), mpq(n)
+        for k in range(2 if cosine else 1, self.qx + 1, 2):
+            sign = (-1) ** (k // 2)
+            z[0][k] = mpq(sign) * nu ** (k - 1) * ((n + 1) ** k - n**k) / factorial(k)
+        return z
+
     def cross(self, u, v):
         m, a = self.mul, self.add
         return (a(m(u[1], v[2]), self.scale(m(u[2], v[1]), -1)),
@@ -175,18 +185,21 @@ def _q(v) -> mpq:
     return mpq(f.numerator, f.denominator)
 
 
-def _rotation_vector(b: _Bivariate, st: Structure, pairs, triples):
+def _rotation_vector(b: _Bivariate, st: Structure, pairs, triples, spin=0):
     """φ of the update starting at t = 0, per component, from the closed-form increments.
 
     ``θ_n = (−(1 − cos a) x, sin a (cos(s+1)x − cos sx), sin a (sin(s+1)x − sin sx))`` for
-    node ``s`` (Li & Zhang (2017) eq. 7, increments over ``[s h, (s+1) h]``, ``Ω = 1``).
+    node ``s`` (Li & Zhang (2017) eq. 7, increments over ``[s h, (s+1) h]``, ``Ω = 1``);
+    with body spin ``σ = ω_s/Ω`` (:class:`~strapdown.truth.motions.SpinConing`) the axial
+    increment gains ``σ x`` and the transverse ones turn at ``ν = 1 − σ``:
+    ``sin a (cos ν(s+1)x − cos νsx)/ν`` and likewise with sines.
     """
     sa, ca = b.trig_a(False), b.trig_a(True)
-    minus_g_x = b.xshift(b.add(ca, b.const(-1)), 1)
+    minus_g_x = b.xshift(b.add(ca, b.const(mpq(spin) - 1)), 1)
+    nu = 1 - mpq(spin)
     th = []
     for s in st.nodes:
-        re = b.add(b.trig_x(s + 1, True), b.scale(b.trig_x(s, True), -1))
-        im = b.add(b.trig_x(s + 1, False), b.scale(b.trig_x(s, False), -1))
+        re, im = b.trig_diff_x(nu, s, True), b.trig_diff_x(nu, s, False)
         th.append((minus_g_x, b.mul(sa, re), b.mul(sa, im)))
     phi = [b.zero(), b.zero(), b.zero()]
     terms: list[tuple[tuple, mpq]] = [(t, _q(w)) for t, w in zip(th, st.weights, strict=True)]
@@ -206,22 +219,25 @@ def _rotation_vector(b: _Bivariate, st: Structure, pairs, triples):
     return phi, sa, ca
 
 
-def _drift(b: _Bivariate, st: Structure, pairs, triples) -> _Series:
-    """Drift about the cone axis over Ω, ``Δ n_x / (Ω T)``, as a bivariate series."""
-    phi, sa, ca = _rotation_vector(b, st, pairs, triples)
+def _drift(b: _Bivariate, st: Structure, pairs, triples, spin=0) -> _Series:
+    """Drift about the cone axis over Ω, ``Δ n_x / (Ω T)``, as a bivariate series (body spin
+    ``σ``: ``ρ = exp(x̂ (1 − σ)ΩT/2)``, see :mod:`strapdown.analysis.frequency_response`)."""
+    phi, sa, ca = _rotation_vector(b, st, pairs, triples, spin)
     s2 = b.add(*(b.mul(p, p) for p in phi))
-    kmax = b.pa // 2 + 1
+    kmax = b.pa // 2 + 1 if not spin else b.qx // 2 + 2  # with spin |φ|² is O(x²) only
     ew = b.power_series([mpq((-1) ** k, 4**k * factorial(2 * k)) for k in range(kmax)], s2)
     sv = b.power_series([mpq((-1) ** k, 2 * 4**k * factorial(2 * k + 1)) for k in range(kmax)],
                         s2)
     ev = [b.mul(sv, p) for p in phi]
     u = mpq(st.update)
     cr, sr = b.trig_x(u / 2, True), b.trig_x(u / 2, False)
+    nu = 1 - mpq(spin)
+    rc, rs = (cr, sr) if not spin else (b.trig_x(u * nu / 2, True), b.trig_x(u * nu / 2, False))
     neg = functools.partial(b.scale, c=-1)
-    aw = b.add(b.mul(ew, cr), neg(b.mul(ev[0], sr)))  # E ⊗ ρ, ρ = (cos ΩT/2, sin ΩT/2, 0, 0)
-    ax = b.add(b.mul(ew, sr), b.mul(ev[0], cr))
-    ay = b.add(b.mul(ev[1], cr), b.mul(ev[2], sr))
-    az = b.add(b.mul(ev[2], cr), neg(b.mul(ev[1], sr)))
+    aw = b.add(b.mul(ew, rc), neg(b.mul(ev[0], rs)))  # E ⊗ ρ, ρ = (cos νΩT/2, sin νΩT/2, 0, 0)
+    ax = b.add(b.mul(ew, rs), b.mul(ev[0], rc))
+    ay = b.add(b.mul(ev[1], rc), b.mul(ev[2], rs))
+    az = b.add(b.mul(ev[2], rc), neg(b.mul(ev[1], rs)))
     y = b.sqrt(b.xshift(b.add(b.mul(ax, ax), b.mul(ay, ay), b.mul(az, az)), -2), u / 2)
     vabs = b.xshift(y, 1)  # |vec(E ρ)| = sin(ψ/2)
     num = b.add(b.mul(vabs, cr), neg(b.mul(aw, sr)))  # tan(ψ/2 − ΩT/2) = num/den
@@ -235,14 +251,17 @@ def _drift(b: _Bivariate, st: Structure, pairs, triples) -> _Series:
 
 
 def drift_series(structure: Structure, coefficients: Sequence, triple_coefficients: Sequence = (),
-                 *, x_order: int | None = None) -> dict[int, tuple[Fraction, ...]]:
+                 *, x_order: int | None = None, spin_ratio=0, a_order: int = A_ORDER
+                 ) -> dict[int, tuple[Fraction, ...]]:
     """Exact double series of the classical-coning drift about the cone axis.
 
     ``drift = Ω Σ_{p, q} d[p][q] a^p (Ωh)^q`` (rad/s, the sign of Li & Zhang (2017) Table 1
     reversed: ``d = −c``), for the increment ``structure`` with pair ``coefficients`` and
     ``triple_coefficients`` (one per ``structure.triples``), to ``a^{A_ORDER}`` and
     ``x^{x_order}`` (default ``2N + 6``). Returns ``{p: (d[p][0], …, d[p][x_order])}`` for
-    even ``p``; odd powers of ``a`` vanish.
+    even ``p``; odd powers of ``a`` vanish. ``spin_ratio``: body spin over cone rate,
+    ``ω_s/Ω`` (exact rational; the motion of :class:`~strapdown.truth.motions.SpinConing`);
+    ``a_order``: the highest power of ``a`` carried (a smaller one is faster).
     """
     if structure.input != "increment":
         raise ValueError("the finite-amplitude series is derived for increment input only; "
@@ -254,11 +273,11 @@ def drift_series(structure: Structure, coefficients: Sequence, triple_coefficien
         raise ValueError(f"{len(structure.triples)} triple coefficients expected, "
                          f"got {len(triple_coefficients)}")
     x_order = 2 * structure.n + 6 if x_order is None else int(x_order)
-    b = _Bivariate(A_ORDER, x_order + 3)  # the divisions by x lose three orders
+    b = _Bivariate(int(a_order), x_order + 3)  # the divisions by x lose three orders
     d = _drift(b, structure, list(zip(structure.pairs, coefficients, strict=True)),
-               list(zip(structure.triples, triple_coefficients, strict=True)))
+               list(zip(structure.triples, triple_coefficients, strict=True)), _q(spin_ratio))
     return {p: tuple(Fraction(int(v.numerator), int(v.denominator)) for v in d[p][:x_order + 1])
-            for p in range(0, A_ORDER + 1, 2)}
+            for p in range(0, int(a_order) + 1, 2)}
 
 
 def leading_terms(series: dict[int, tuple[Fraction, ...]]
@@ -329,3 +348,88 @@ def derive_triple(structure: Structure) -> Design:
         raise ArithmeticError("the triple terms changed the a² drift; the design is wrong")
     return replace(plain, structure=structure, triple_coefficients=tri,
                    amplitude_law=leading_terms(series), conditions=plain.conditions + len(rows))
+
+
+def with_triples_to_last(structure: Structure) -> Structure:
+    """``structure`` with every triple term ``θ_m × (θ_i × θ_L)`` (``θ_L`` the last node,
+    ``i < L``, any ``m``): the candidates of :func:`derive_spin_robust`."""
+    last = len(structure.nodes) - 1
+    triples = tuple((m, i, last) for i in range(last - 1, -1, -1) for m in range(last, -1, -1))
+    return replace(structure, name=f"{structure.name}, triple θ_m×(θ_i×θ_L)", triples=triples)
+
+
+def _spin_x4_rows(structure: Structure, pairs: Sequence[Fraction]):
+    """The a² (Ωh)⁴ drift coefficient under spin as a polynomial in the spin ratio σ: its
+    σ-coefficients for the base (no triple terms) and per triple term (affine, checked)."""
+    k = len(structure.triples)
+    deg = 2 * structure.n + 4  # the polynomial's degree is below this (checked at deg + 1)
+    ss = [Fraction(v) for v in range(deg + 2)]
+
+    def x4(t, s):
+        return drift_series(structure, pairs, t, spin_ratio=s, x_order=4, a_order=2)[2][4]
+
+    zero = (Fraction(0),) * k
+    base = [x4(zero, s) for s in ss]
+    cols = []
+    for j in range(k):
+        e = tuple(Fraction(int(i == j)) for i in range(k))
+        cols.append([x4(e, s) - b for s, b in zip(ss, base, strict=True)])
+    e2 = tuple(Fraction(2 * int(i == 0)) for i in range(k))
+    if k and x4(e2, ss[3]) - base[3] != 2 * cols[0][3]:
+        raise ArithmeticError("the a² (Ωh)⁴ spin term is not affine in the triple terms")
+    sym = sp.Symbol("s")
+
+    def coeffs(vals):
+        poly = sp.Poly(sp.interpolate([(int(s), _to_sp(v)) for s, v in zip(ss, vals,
+                                                                         strict=True)], sym),
+                       sym)
+        c = [sp.Rational(x) for x in reversed(poly.all_coeffs())]
+        if len(c) > deg + 1:
+            raise ArithmeticError("the spin polynomial's degree exceeds the bound")
+        return c + [sp.Rational(0)] * (deg + 1 - len(c))
+
+    return coeffs(base), [coeffs(c) for c in cols]
+
+
+@functools.lru_cache(maxsize=32)
+def derive_spin_robust(structure: Structure, *, amplitude: bool = True) -> Design:
+    """Triple coefficients that cancel the ``a² (Ωh)⁴`` drift for every spin/cone ratio at
+    once (spin plus coning, :class:`~strapdown.truth.motions.SpinConing`), and with
+    ``amplitude`` also the classical-coning ``a⁴`` drift through the ``a²`` law's order.
+
+    The pair coefficients are the classical ``a²`` design's. Under spin the axial increment
+    is ``O(1)``, so triple terms enter the ``a²`` drift; its ``(Ωh)⁴`` coefficient is affine
+    in them and a polynomial in the ratio ``σ = ω_s/Ω`` (exact interpolation over
+    ``σ = 0, 1, …``): every ``σ``-coefficient is a linear condition. Higher powers of ``Ωh``
+    are quadratic in the triple terms and stay. The conditions must all be met (an error
+    otherwise); free coefficients are settled by minimum norm (exact).
+    """
+    if not structure.triples:
+        raise ValueError(f"{structure.name!r} has no triple terms; add them with "
+                         "with_triples_to_last()")
+    plain = derive(replace(structure, triples=()))
+    base, cols = _spin_x4_rows(structure, plain.coefficients)
+    rows = [[c[d] for c in cols] for d in range(len(base))]
+    rhs = [-b for b in base]
+    if amplitude:
+        top = plain.order if plain.order is not None else 2 * structure.n
+        zeros = (Fraction(0),) * len(structure.triples)
+        b4 = drift_series(structure, plain.coefficients, zeros)[4]
+        c4 = []
+        for k in range(len(structure.triples)):
+            unit = tuple(Fraction(int(i == k)) for i in range(len(zeros)))
+            c4.append([v - w for v, w in zip(drift_series(structure, plain.coefficients,
+                                                          unit)[4], b4, strict=True)])
+        rows += [[_to_sp(c[q]) for c in c4] for q in range(top + 1)]
+        rhs += [-_to_sp(b4[q]) for q in range(top + 1)]
+    a, bvec = sp.Matrix(rows), sp.Matrix(rhs)
+    if a.rank() != a.row_join(bvec).rank():
+        raise ValueError(f"{structure.name!r}: its triple terms cannot meet every condition; "
+                         "give more (with_triples_to_last)")
+    _, piv = a.T.rref()
+    a, bvec = a.extract(list(piv), list(range(a.cols))), bvec.extract(list(piv), [0])
+    sol = a.T * (a * a.T).LUsolve(bvec)
+    tri = tuple(Fraction(int(sp.fraction(v)[0]), int(sp.fraction(v)[1])) for v in sol)
+    series = drift_series(structure, plain.coefficients, tri)
+    return replace(plain, structure=structure, triple_coefficients=tri,
+                   amplitude_law=leading_terms(series), conditions=plain.conditions + a.rows)
