@@ -31,6 +31,12 @@ Result (N = 3 … 6, both structures; :func:`derive_triple`): with the triple te
 ``a⁴ x⁴`` term; the ``a⁶ x⁶`` term remains (it is quadratic in the triple coefficients, so
 this linear design cannot remove it) and dominates the conventional N = 5, 6 sets at small
 ``x``, where the drift is far below the float64 floor.
+
+Spin plus coning (``spin_ratio`` σ = ω_s/Ω, :func:`derive_spin_robust`): with body spin the
+axial increment is ``O(1)``, the ``a²`` drift of Table 3 drops to ``(Ωh)⁴`` (e.g.
+``−12/5 a²Ω(Ωh)⁴`` for N = 3 at σ = 3), and triple terms enter it. Its ``(Ωh)⁴``
+coefficient is affine in them and polynomial in σ, so a few triple terms cancel it for every
+ratio at once — N = 3: ``+51/40 θ3×(θ2×θ3) − 39/40 θ3×(θ1×θ3)``.
 """
 
 from __future__ import annotations
