@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 from scipy.io import savemat
 
+from conftest import BROAD
 from strapdown.cli import main
 from strapdown.rotation.dcm import dcm_from_quat
 from strapdown.truth.motions import SpinConing
@@ -57,22 +58,50 @@ def test_ahrs_gyro_in_deg_s_declared_rad_s_fails(tmp_path, capsys):
            "more likely in deg/s (declared rad/s); nothing computed", tmp_path, ["imu.csv"])
 
 
-def test_ahrs_diverged_filter_fails_instead_of_writing_nans(tmp_path, capsys):
-    # 90 °/s spin in deg/s declared rad/s: 91 "rad/s" passes the magnitude check, the
-    # filter diverges (bias 1e58, NaN quaternions) — caught at the output stage
+def test_ahrs_gyro_units_judged_against_the_magnetometer(tmp_path, capsys):
+    # 90 °/s spin in deg/s declared rad/s: 91 "rad/s" passes the magnitude check, and the
+    # filter no longer diverges on it — the magnetometer, which turns 57× slower than such a
+    # gyro says, is what tells
     t, w, a, m = _imu(90.0)
     log = _csv(tmp_path / "imu.csv", PLAIN, t, np.degrees(w), a, m)
     _fails(capsys, ["ahrs", "--imu", log, "--gyro-units", "rad/s", "--acc-units", "m/s2",
                     "--out", str(tmp_path / "a.csv")],
-           "the filter diverged at output row", tmp_path, ["imu.csv"])
-    err_line = "Are the gyro units right (declared rad/s)?"
-    with pytest.raises(SystemExit):
-        main(["ahrs", "--imu", log, "--gyro-units", "rad/s", "--acc-units", "m/s2", "--out",
-              str(tmp_path / "a.csv")])
-    assert err_line in capsys.readouterr().err
+           "the gyro is more likely in deg/s (declared rad/s)", tmp_path, ["imu.csv"])
+    # the other way round: rad/s data declared deg/s
+    log2 = _csv(tmp_path / "imu2.csv", PLAIN, t, w, a, m)
+    _fails(capsys, ["ahrs", "--imu", log2, "--gyro-units", "deg/s", "--acc-units", "m/s2",
+                    "--out", str(tmp_path / "a.csv")],
+           "the gyro is more likely in rad/s (declared deg/s)", tmp_path,
+           ["imu.csv", "imu2.csv"])
     # declared right, the same recording runs
     assert main(["ahrs", "--imu", log, "--gyro-units", "deg/s", "--acc-units", "m/s2",
                  "--out", str(tmp_path / "a.csv")]) == 0
+
+
+@pytest.mark.skipif(BROAD is None, reason="BROAD trials not found (set STRAPDOWN_BROAD)")
+def test_gyro_scale_separates_the_units_on_every_broad_trial():
+    from strapdown.apps.ahrs_log import GYRO_SCALE_LIMITS, gyro_scale
+    from strapdown.io.broad import read_broad
+
+    lo, hi = GYRO_SCALE_LIMITS
+    for f in sorted(BROAD.glob("*.mat")):
+        tr = read_broad(f)
+        assert lo <= gyro_scale(tr.t, tr.gyro, tr.mag) <= hi, f.name  # measured 0.90–0.99
+        assert gyro_scale(tr.t, np.degrees(tr.gyro), tr.mag) < lo, f.name  # 0.016–0.017
+        assert gyro_scale(tr.t, np.radians(tr.gyro), tr.mag) > hi, f.name  # 52–57
+
+
+def test_diverged_filter_is_refused_at_the_output_stage():
+    from strapdown.ahrs import ekf
+    from strapdown.apps.ahrs_log import _check_output
+
+    n = 200
+    t = np.arange(n) / 100.0
+    res = ekf(t, np.zeros((n, 3)), np.tile([0.0, 0.0, 9.80665], (n, 1)),
+              np.tile([0.0, 20.0, -40.0], (n, 1)))
+    res.q[50] = np.nan
+    with pytest.raises(ValueError, match="the filter diverged at output row"):
+        _check_output(res, "rad/s")
 
 
 def _broad(path, n=600, fs=100.0):

@@ -43,7 +43,13 @@ from strapdown._core.errors import InputError, shown
 from strapdown.ahrs import AhrsConfig, AhrsResult, MeasurementFlag, ekf, offline_ekf
 from strapdown.algorithms.rate import resample_uniform
 from strapdown.apps._logs import output_with_sidecar, rate_records, unit_action
-from strapdown.io import check_rows, csv_columns, warn_implausible_rate, write_attitude
+from strapdown.io import (
+    UnitWarning,
+    check_rows,
+    csv_columns,
+    warn_implausible_rate,
+    write_attitude,
+)
 from strapdown.io.readers import (
     ACC_COLUMNS,
     GYRO_COLUMNS,
@@ -185,6 +191,8 @@ def read_ahrs_log(path, *, gyro_units: str | None = None, acc_units: str | None 
     if au == "g":
         a = a * 9.80665
     warn_implausible_rate(path, g, gu, suggestion="deg/s", action=unit_check)
+    if m is not None and use_magnetometer:
+        _check_gyro_scale(path, t, g, m, gu, unit_check)
     d = np.diff(t)
     unit_h = nominal or float(np.median(d))
     check_motion(path, g, "rate", unit_h)
@@ -197,6 +205,50 @@ def read_ahrs_log(path, *, gyro_units: str | None = None, acc_units: str | None 
     return AhrsLog(t, np.ascontiguousarray(g), np.ascontiguousarray(a),
                    None if (m is None or not use_magnetometer) else np.ascontiguousarray(m),
                    gu, au, gaps, nominal)
+
+
+#: Gyro scale against the magnetometer outside which the declared unit is judged wrong: a
+#: factor 180/π off gives 0.017 or 57; a correct unit gives about 1 (noise, disturbances).
+GYRO_SCALE_LIMITS = (0.2, 5.0)
+
+
+def gyro_scale(t: np.ndarray, gyro: np.ndarray, field: np.ndarray) -> float | None:
+    """The scale ``s`` that best explains the body-frame field's change by the gyro:
+    ``Δm ≈ s · (−ω × m) Δt`` (a constant field seen from a rotating body), least squares
+    over the record; ``None`` when neither the gyro nor the field shows a radian of rotation
+    in all (nothing to judge). ``s ≈ 1`` for consistent units, ``π/180`` for a gyro
+    in deg/s read as rad/s."""
+    dt = np.diff(t)[:, None]
+    w = 0.5 * (gyro[:-1] + gyro[1:])
+    mid = 0.5 * (field[:-1] + field[1:])
+    pred = -np.cross(w, mid) * dt
+    dm = np.diff(field, axis=0)
+    den = float(np.sum(pred * pred))
+    norm = np.linalg.norm(mid, axis=1)
+    if not np.all(norm > 0):
+        return None
+    said = float(np.sum(np.linalg.norm(w, axis=1) * dt[:, 0]))  # what the gyro says (rad)
+    seen = float(np.sum(np.linalg.norm(dm, axis=1) / norm))  # what the field shows (rad)
+    if max(said, seen) < 1.0 or not den > 0:
+        return None
+    return float(np.sum(dm * pred) / den)
+
+
+def _check_gyro_scale(path: Path, t: np.ndarray, g: np.ndarray, m: np.ndarray, gu: str,
+                      unit_check: UnitAction) -> None:
+    """A gyro whose rotation the magnetometer does not see (see :func:`gyro_scale`) is in
+    other units than declared: an error (or a warning when accepted)."""
+    s = gyro_scale(t, g, m)
+    lo, hi = GYRO_SCALE_LIMITS
+    if s is None or lo <= s <= hi:
+        return
+    other = "deg/s" if s < lo else "rad/s"
+    msg = (f"{path}: the magnetometer turns {s:.3g} times as fast as the gyro says; the gyro "
+           f"is more likely in {other} (declared {gu})")
+    if unit_check == "error":
+        raise InputError(f"{msg}; nothing computed. If the declared units are right, pass "
+                         "--accept-unit-warning")
+    warnings.warn(msg, UnitWarning, stacklevel=3)
 
 
 def _check_output(res: AhrsResult, gyro_units: str) -> None:
