@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from fractions import Fraction as F
 
+from strapdown.algorithms.coning import TABLE3
 from strapdown.algorithms.family import RateCoefficients, Rk4Step
 
 __all__ = [
@@ -67,26 +68,12 @@ RK4_DRIFT: dict[Rk4Step, tuple[int, F]] = {"2td": (4, F(-1, 60)), "td-interp": (
 #: ``derive(interval_structure(N), target="sculling")``, for N = 1 … 6. They equal the
 #: classical-coning optimum of the same structure, Li & Zhang (2017) Table 3 (Ignagni's
 #: duality, Ignagni (1998)).
-SCULLING_CONVENTIONAL: dict[int, tuple[F, ...]] = {
-    1: (),
-    2: (F(2, 3),),
-    3: (F(27, 20), F(9, 20)),
-    4: (F(214, 105), F(92, 105), F(18, 35)),
-    5: (F(1375, 504), F(325, 252), F(25, 24), F(125, 252)),
-    6: (F(15797, 4620), F(3917, 2310), F(608, 385), F(2279, 2310), F(463, 924)),
-}
+SCULLING_CONVENTIONAL: dict[int, tuple[F, ...]] = TABLE3  # the duality: the same numbers
 
 #: Sculling compensation of the single chain, ``Σ_m c_m (θ_{k−m} × v_k + v_{k−m} × θ_k)``:
 #: c_1 … c_{N−1} from ``derive(single_chain_structure(N), target="sculling")`` (equal to
 #: :data:`SINGLE_CHAIN`).
-SCULLING_SINGLE_CHAIN: dict[int, tuple[F, ...]] = {
-    1: (),
-    2: (F(1, 12),),
-    3: (F(7, 60), F(-1, 60)),
-    4: (F(113, 840), F(-13, 420), F(1, 280)),
-    5: (F(367, 2520), F(-53, 1260), F(1, 120), F(-1, 1260)),
-    6: (F(4247, 27720), F(-703, 13860), F(61, 4620), F(-31, 13860), F(1, 5544)),
-}
+SCULLING_SINGLE_CHAIN: dict[int, tuple[F, ...]] = SINGLE_CHAIN  # the duality
 
 #: Classical-sculling law of both structures with these sets: (order, c) with the rectified
 #: velocity error rate ``−c · θ0 A cos ψ (Ωh)^order`` along the axis normal to the angular
