@@ -130,6 +130,7 @@ class Params(NamedTuple):
     gyro_noise: float
     gyro_bias_rw: float
     tilt_rate_noise: float
+    heading_rate_noise: float
     singer_sigma: float
     singer_tau: float
     acc_noise: float
@@ -165,6 +166,7 @@ class Params(NamedTuple):
     mag_new_min_rate: float
     mag_reject_s: float
     mag_disturbed_factor: float
+    mag_disturbed_power: float
     lp_b0: float  #: the accelerometer low-pass (second-order Butterworth at the epoch
     lp_b1: float  #: period): numerator,
     lp_b2: float
@@ -595,13 +597,16 @@ def _propagate_covariance(P, phi, T, decay, singer, A, M):
 def _add_process_noise(P, C, phi, T, qg, qb, qa, qab, params, singer):
     """Stage 3: ``P += Q``. The attitude gets the gyro's white noise and, for the gyro's
     scale-factor and misalignment errors, ``tilt_rate_noise² |ω|² T`` on the two tilt
-    axes only (horizontal in the reference frame: ``I − c cᵀ`` in the body frame with
-    c = C₃ᵀ, the vertical), so a fast rotation lets the accelerometer correct tilt
-    sooner without opening the heading to magnetic disturbances."""
-    qs = params.tilt_rate_noise ** 2 * (phi[0] ** 2 + phi[1] ** 2 + phi[2] ** 2) / T
+    axes (horizontal in the reference frame: ``I − c cᵀ`` in the body frame with
+    c = C₃ᵀ, the vertical) and ``heading_rate_noise² |ω|² T`` on the heading (``c cᵀ``):
+    a fast rotation lets the accelerometer correct tilt sooner, and the heading's
+    uncertainty grows with the rotation while the field is rejected."""
+    w2 = (phi[0] ** 2 + phi[1] ** 2 + phi[2] ** 2) / T
+    qs = params.tilt_rate_noise ** 2 * w2
+    qv = params.heading_rate_noise ** 2 * w2 - qs
     for r in range(3):
         for c in range(3):
-            P[r, c] += ((qg + qs) if r == c else 0.0) - qs * C[2, r] * C[2, c]
+            P[r, c] += ((qg + qs) if r == c else 0.0) + qv * C[2, r] * C[2, c]
     nx = P.shape[0]
     for r in range(3):
         P[3 + r, 3 + r] += qb
@@ -853,6 +858,18 @@ def _mag_disturbance(T, rate2, params, nd, ms):
     if ms[M_DIST] == 0.0:
         ms[M_REJECT] = max(ms[M_REJECT] - params.mag_disturbed_factor * T, 0.0)
     return ms[M_DIST] > 0.0
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _disturbed_factor(params, nd, ms):
+    """Stage 6: the heading noise's variance factor for a disturbed field used beyond the
+    rejection budget: ``mag_disturbed_factor`` times the squared departure from the
+    reference in tolerances (norm or dip, the larger; at least 1) to the power
+    ``mag_disturbed_power`` — a mild disturbance is de-weighted, a strong one all but
+    rejected."""
+    dn = (nd[0] - ms[M_NORM]) / (params.mag_norm_tol * ms[M_NORM])
+    dd = (nd[1] - ms[M_DIP]) / params.mag_dip_tol
+    return params.mag_disturbed_factor * max(1.0, dn * dn, dd * dd) ** params.mag_disturbed_power
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -1155,7 +1172,8 @@ def ekf_kernel(sensors, prop, window, params, init, out):
                     flags |= _mag_recovery(params, P, C)
                 _heading_model(params, C, mn, dx, H_mag, y1)
                 nis_mag, ok = _consider_update(P, H_mag, params.heading_noise ** 2 / T
-                                               * (params.mag_disturbed_factor if dist else 1.0),
+                                               * (_disturbed_factor(params, nd, ms) if dist
+                                                  else 1.0),
                                                y1, params.mag_gate,
                                                params.gating, force, dx, C, ku, kk)
                 bits, mag_bad_since = _outcome(ok, tk, mag_bad_since, F_MAG_USED,
@@ -1186,3 +1204,22 @@ def ekf_kernel(sensors, prop, window, params, init, out):
         out_nis[k, 0] = nis_acc
         out_nis[k, 1] = nis_mag
     return total
+
+
+@njit(cache=True, error_model="numpy")
+def predict(q, omega, bias, lead, out):
+    """``out[i] = q[i] ⊗ q(lead (ω_i − b_i))`` for rows 1 …: each attitude predicted over
+    ``lead`` seconds on its bias-corrected rate (the samples' latency); row 0 copied."""
+    for i in range(4):
+        out[0, i] = q[0, i]
+    eps = np.empty(3)
+    for k in range(1, q.shape[0]):
+        for a in range(3):
+            eps[a] = (omega[k, a] - bias[k, a]) * lead
+        dw, s = _small_rotation(eps)
+        ex, ey, ez = s * eps[0], s * eps[1], s * eps[2]
+        w0, x0, y0, z0 = q[k, 0], q[k, 1], q[k, 2], q[k, 3]
+        out[k, 0] = w0 * dw - x0 * ex - y0 * ey - z0 * ez
+        out[k, 1] = w0 * ex + x0 * dw + y0 * ez - z0 * ey
+        out[k, 2] = w0 * ey - x0 * ez + y0 * dw + z0 * ex
+        out[k, 3] = w0 * ez + x0 * ey - y0 * ex + z0 * dw

@@ -1,37 +1,51 @@
 """Attitude and heading reference: a multiplicative error-state EKF (Wang, Wang & Wang, eqs. 30–35).
 
 The filter (Wang, Wang & Wang's attitude filter, rebuilt from the paper's text
-and made well-posed; docs/reproductions.md says what the paper leaves open):
+and made well-posed — docs/reproductions.md says what the paper leaves open —
+with the accelerometer and magnetometer handling of Laidig & Seel (2023)):
 
-- **state** ``x = [δθ_b, δb_g, a_b]``: attitude error in the body frame
-  (``q_true = q̂ ⊗ q(δθ_b)``), gyro-bias error, and the manoeuvre
-  (non-gravitational) acceleration in the body frame as a first-order
-  Gauss–Markov (Singer) process ``ȧ = −a/τ + w``; optionally the
-  accelerometer bias ``δb_a`` (12 states, ``estimate_acc_bias``);
+- **state** ``x = [δθ_b, δb_g]``: attitude error in the body frame
+  (``q_true = q̂ ⊗ q(δθ_b)``) and gyro-bias error; with the paper's raw
+  accelerometer model also the manoeuvre (non-gravitational) acceleration in the
+  body frame as a first-order Gauss–Markov (Singer) process ``ȧ = −a/τ + w``;
+  optionally the accelerometer bias ``δb_a`` (``estimate_acc_bias``);
 - **propagation** of the attitude by any of the library's algorithms on the
   bias-corrected gyro: ``rate-single``, ``rate-three`` (conventional or
   ``structure=sliding``), ``rk4`` (step 2 td) and ``rotvec:N=…`` (on
   increments formed from the rates by the trapezoid rule); covariance by
-  ``Φ = [[exp(−[φ×]), −T I, 0], [0, I, 0], [0, 0, e^{−T/τ} I]]``;
+  ``Φ = [[exp(−[φ×]), −T I], [0, I]]`` (and ``e^{−T/τ} I`` on the Singer state),
+  with a tilt noise proportional to the rotation rate (``tilt_rate_noise``);
 - **updates** at every attitude output: a zero-rate update of the bias while
-  the sensor is at rest (gyro and accelerometer variance below thresholds),
-  the accelerometer ``f = C_b_n g_up + a_b`` (``H = [[v̂×], 0, I]``) and the
-  magnetometer as a heading measurement only (the heading of the field in the
-  reference frame, ``H = [−(C_n_b)₃ᵀ, 0, 0]``), so magnetic disturbances never
-  reach roll and pitch; Joseph form, sequential, then reset;
+  the sensor is at rest (gyro and accelerometer variance below thresholds);
+  the accelerometer — by default the specific force rotated into the reference
+  frame through a second-order Butterworth low-pass, whose states follow every
+  correction (an almost-inertial frame, Laidig & Seel's), taken as gravity on its
+  horizontal axes; or the paper's ``f = C_b_n g_up + a_b`` for every sample — and
+  the magnetometer as a heading measurement: the field, rotated with the attitude
+  of the magnetometer's delay earlier (estimated online), gives the heading of its
+  horizontal part; the innovation variance carries the tilt uncertainty through
+  the dip, the gain stays off roll and pitch (magnetic disturbances never reach
+  them); sequential, exact for the gain used, then reset;
+- **magnetic disturbances** (Laidig & Seel (2023), Sec. 2.5): the field's
+  low-passed norm and dip against a reference learned slowly while undisturbed;
+  a new field is accepted after ``mag_new_s`` of consistent rotation; a disturbed
+  field is rejected for at most ``mag_reject_s`` (a budget that refills while
+  undisturbed), then used de-weighted (``mag_disturbed_factor``);
 - **gating**: an accelerometer or heading innovation whose NIS exceeds a χ²
-  threshold is rejected; a magnetometer sample whose norm or dip angle
-  departs from the reference field is rejected before that, and after a
-  magnetic disturbance the field must stay plausible for ``mag_settle_s``.
-  Recovery: when innovations keep failing the gate although the measurement
-  itself looks clean — the accelerometer quiet (low variance, norm g) for
-  ``recover_acc_s``, or a plausible field for ``recover_mag_s`` — the filter,
-  not the sensor, must be wrong: it inflates the affected covariance and
-  accepts again;
+  threshold is rejected. Recovery: when innovations keep failing the gate although
+  the measurement itself looks clean — the accelerometer quiet (low variance,
+  norm g) for ``recover_acc_s``, or an undisturbed field for ``recover_mag_s`` —
+  the filter, not the sensor, must be wrong: it inflates the affected covariance
+  and accepts again;
 - **initial attitude** from the mean accelerometer and magnetometer over
   ``init_window_s`` (TRIAD) when none is given (the window is assumed at
   rest); the reference field (norm, dip, heading) is learned there too,
   unless given.
+
+:func:`ekf` is causal (one pass, no sample after the estimate's own is used);
+:func:`offline_ekf` adds a backward pass and combines the two (Fraser & Potter
+(1969)) for post-processing — acausal. Output: one row per input sample, the first
+the initial attitude (:class:`AhrsResult`).
 
 Frames: the filter runs in ENU (x east, y north, z up); ``frame="NED"``
 returns q_NED_b. Heading is magnetic unless ``declination_deg`` is given.
@@ -83,6 +97,10 @@ class AhrsConfig:
         scale-factor and misalignment errors make the tilt more uncertain the faster
         the sensor turns, ``Q_tilt = tilt_rate_noise² |ω|² T`` on the two horizontal
         axes (CV; 0 switches it off).
+    heading_rate_noise : float
+        The same for the heading axis (CV): while the field is rejected, the heading's
+        uncertainty grows with the rotation, so the field weighs more once it is used
+        again.
     singer_sigma : float
         Raw model: steady-state standard deviation of the manoeuvre acceleration, m/s².
         Default 2.
@@ -119,8 +137,8 @@ class AhrsConfig:
         variance also carries the tilt uncertainty times tan(dip), and its gain never
         reaches roll and pitch.
     acc_gate, mag_gate : float
-        NIS thresholds: χ² with 3 dof at 99.9 % (16.27) for the raw accelerometer,
-        1 dof at 99 % (6.63, CV) for the heading.
+        NIS thresholds: χ² with 3 dof at 99.9 % (16.27) for the raw accelerometer; for
+        the heading 4.0 (CV; 1 dof at 95.4 %).
     mag_norm_tol : float
         The field is disturbed when its (low-passed) norm departs from the reference
         by more than this fraction (CV) …
@@ -143,8 +161,10 @@ class AhrsConfig:
         A disturbed field is rejected for at most this many seconds (the budget
         refills ``mag_disturbed_factor`` times faster while undisturbed); beyond it,
         it is used with its noise density scaled by √``mag_disturbed_factor`` (CV).
-    mag_disturbed_factor : float
-        That variance factor (CV).
+    mag_disturbed_factor, mag_disturbed_power : float
+        That variance factor, times the squared departure from the reference in
+        tolerances (norm or dip, the larger) to this power: a mild disturbance is
+        de-weighted, a strong one all but rejected (CV).
     mag_delay_s : float
         Delay of the magnetometer behind the gyro, s: each field sample is rotated
         with the attitude of that long ago (rounded to whole filter epochs). With
@@ -155,10 +175,19 @@ class AhrsConfig:
         frame (``ṁ = −ω × m``), averaged over ``mag_delay_tau_s``.
     mag_delay_max_s, mag_delay_tau_s : float
         Its largest candidate and averaging time, s. Defaults 0.02, 10.
+    gyro_sample : {"interval", "point"}
+        What a gyro sample is. ``interval`` (default, CV): the mean rate over the sample
+        period that ends at its time stamp — what a MEMS IMU's decimation filter
+        delivers, and what VQF, Madgwick's filter and Fusion assume when they turn
+        each sample over the step that ends at it; the propagation algorithms take
+        their samples as points, so their attitude refers to half a period earlier
+        and each output is predicted that half period ahead on the bias-corrected gyro
+        (causal). ``point``: the rate at the stamp (the library's rate algorithms'
+        convention, and an exact simulation's).
     latency_s : float
-        Latency of the IMU's samples behind the motion they measure (its internal
-        filters' group delay), s: each output attitude is predicted that far ahead on
-        the bias-corrected gyro. Causal. Default 0 (no prediction).
+        A further latency of the IMU's samples behind the motion they measure (its
+        internal filters' group delay), s: each output attitude is predicted that far
+        ahead too. Causal. Default 0.
     acc_norm_tol : float
         Raw model only: skip the accelerometer when its norm departs from g by
         more than this fraction (sustained manoeuvres, impacts). Default 0.25.
@@ -200,21 +229,22 @@ class AhrsConfig:
         m/s². Default 9.80665.
     """
 
-    gyro_noise: float = 1.4e-3
-    gyro_bias_rw: float = 1.8e-6
+    gyro_noise: float = 9.8e-4
+    gyro_bias_rw: float = 2.5e-6
     gyro_bias_sigma0: float = 0.01
-    tilt_rate_noise: float = 0.003
+    tilt_rate_noise: float = 4.2e-3
+    heading_rate_noise: float = 5e-4
     singer_sigma: float = 2.0
     singer_tau: float = 0.2
     acc_noise: float = 0.03
-    heading_noise: float = 0.0126
+    heading_noise: float = 0.036
     acc_gate: float = 16.27
-    mag_gate: float = 6.63
-    mag_norm_tol: float = 0.05
-    mag_dip_tol: float = 0.1745
+    mag_gate: float = 4.0
+    mag_norm_tol: float = 0.2
+    mag_dip_tol: float = 0.12215
     acc_model: str = "lowpass"
     acc_lowpass_s: float = 2.1
-    acc_lowpass_noise: float = 0.018
+    acc_lowpass_noise: float = 0.036
     acc_gate_lowpass: float = 13.82
     acc_gate_mode: str = "hard"
     lever_arm: float = 0.1
@@ -224,18 +254,20 @@ class AhrsConfig:
     mag_current_s: float = 0.05
     mag_new_s: float = 20.0
     mag_new_min_rate: float = 0.349
-    mag_reject_s: float = 0.0
-    mag_disturbed_factor: float = 8.0
+    mag_reject_s: float = 60.0
+    mag_disturbed_factor: float = 2.0
+    mag_disturbed_power: float = 0.0
     mag_delay_s: float = 0.0
     estimate_mag_delay: bool = True
     mag_delay_max_s: float = 0.02
     mag_delay_tau_s: float = 10.0
+    gyro_sample: str = "interval"
     latency_s: float = 0.0
     recover_acc_s: float = 2.0
     recover_mag_s: float = 10.0
     recover_angle: float = 0.1
     rest_gyro: float = 0.04
-    rest_acc: float = 0.4
+    rest_acc: float = 0.2
     rest_noise: float = 1.2e-4
     rest_tau: float = 0.5
     estimate_acc_bias: bool = False
@@ -254,6 +286,9 @@ class AhrsConfig:
         if self.acc_model not in ("lowpass", "raw"):
             raise ValueError(f"AhrsConfig.acc_model must be 'lowpass' or 'raw', got "
                              f"{self.acc_model!r}")
+        if self.gyro_sample not in ("interval", "point"):
+            raise ValueError(f"AhrsConfig.gyro_sample must be 'interval' or 'point', got "
+                             f"{self.gyro_sample!r}")
         if self.acc_gate_mode not in ("soft", "hard"):
             raise ValueError(f"AhrsConfig.acc_gate_mode must be 'soft' or 'hard', got "
                              f"{self.acc_gate_mode!r}")
@@ -276,8 +311,8 @@ class AhrsConfig:
 
 #: AhrsConfig fields that may be negative, and those that may be zero.
 _ANY_SIGN = ("declination_deg",)
-_NON_NEGATIVE = ("lever_arm", "tilt_rate_noise", "mag_reject_s", "mag_delay_s", "latency_s",
-                 "mag_delay_max_s")
+_NON_NEGATIVE = ("lever_arm", "tilt_rate_noise", "heading_rate_noise", "mag_reject_s",
+                 "mag_delay_s", "latency_s", "mag_delay_max_s", "mag_disturbed_power")
 
 
 @dataclass(frozen=True)
@@ -616,13 +651,14 @@ def _fill(rec, out: K.Outputs, k: int) -> np.ndarray:
 def _result(rec, out: K.Outputs, epoch, frame: str, have_mag: bool, algorithm: str,
             cfg: AhrsConfig, smoothed: bool = False) -> AhrsResult:
     """The :class:`AhrsResult` of completed per-sample outputs (:func:`_fill`): the
-    attitudes predicted over ``latency_s`` when it is set, then turned into ``frame``."""
+    attitudes after the initial one predicted over half a sample period
+    (``gyro_sample="interval"``) plus ``latency_s``, then turned into ``frame``."""
     q, bias = out.q, out.gyro_bias
     sigma = np.sqrt(np.maximum(np.diagonal(out.attitude_cov, axis1=1, axis2=2), 0.0))
-    if cfg.latency_s > 0:  # predict each attitude over the sensor's latency (causal)
-        from strapdown.rotation.quaternion import quat_from_rotvec
-
-        q = quat_multiply(q, quat_from_rotvec((rec.omega - bias) * cfg.latency_s))
+    lead = cfg.latency_s + (0.5 * rec.td if cfg.gyro_sample == "interval" else 0.0)
+    if lead > 0:  # predict each attitude but the initial one over the latency (causal)
+        q = np.empty_like(out.q)
+        K.predict(out.q, rec.omega, bias, float(lead), q)
     if frame == "NED":
         q = quat_multiply(Q_NED_ENU, q)
     return AhrsResult(rec.t, np.arange(rec.t.size), epoch, q, frame, have_mag, bias,

@@ -28,7 +28,9 @@ class MeasurementFlag(enum.IntFlag):
         Its innovation failed the NIS gate: not applied.
     MAG_DISTURBED
         The field's norm or dip departed from the reference, or had not yet
-        stayed plausible for ``mag_settle_s``: no heading update.
+        stayed within the tolerances for ``mag_settle_s``: no heading update while
+        the rejection budget ``mag_reject_s`` lasts, a de-weighted one (with
+        ``MAG_USED``) after it.
     REST
         The rest detector fired: a zero-rate update of the gyro bias.
     ACC_RECOVERED
