@@ -184,6 +184,7 @@ class Params(NamedTuple):
     estimate_mag_delay: bool  #: estimate the delay online (:func:`_fold_delay_samples`)
     mag_delay_max: int  #: the estimator's largest candidate, samples
     mag_delay_alpha: float  #: its averaging gain per sample
+    store_covariance: bool  #: write attitude_cov and bias_var (the offline combination)
 
 
 class Initial(NamedTuple):
@@ -197,10 +198,12 @@ class Initial(NamedTuple):
 class Outputs(NamedTuple):
     """The outputs, allocated by the caller with a row per sample (n): each epoch writes
     the row of its sample k — q (n, 4), gyro_bias, accel, acc_bias (n, 3), flags (n,)
-    int64, nis (n, 2) (accelerometer, heading; NaN without an update), attitude_cov
-    (n, 3, 3) (of δθ_b), bias_var (n, 3) (the gyro bias's variances), mag_delay (n,)
-    int64 (the magnetometer delay in use, samples) — and ``sample[e]``, epoch e's
-    sample index; other rows are left as they were."""
+    int64, nis (n, 2) (accelerometer, heading; NaN without an update), attitude_sigma
+    (n, 3), attitude_cov (n, 3, 3) (of δθ_b) and bias_var (n, 3) (the gyro bias's
+    variances; only with ``Params.store_covariance``), mag_delay (n,) int64 (the
+    magnetometer delay in use, samples) — and ``sample[e]``, epoch e's sample index;
+    other rows are left as they were (accel and acc_bias are not written without their
+    states)."""
 
     q: np.ndarray
     gyro_bias: np.ndarray
@@ -209,6 +212,7 @@ class Outputs(NamedTuple):
     sample: np.ndarray
     flags: np.ndarray
     nis: np.ndarray
+    attitude_sigma: np.ndarray
     attitude_cov: np.ndarray
     bias_var: np.ndarray
     mag_delay: np.ndarray
@@ -986,7 +990,8 @@ def ekf_kernel(sensors, prop, window, params, init, out):
     is_rate, lag = prop.is_rate, prop.lag
     nx = init.P.shape[0]  # 6; 9 with the Singer state (raw model); + 3 with the acc bias
     singer = not params.acc_lowpass
-    out_q, out_b, out_a, out_ab, out_idx, out_flags, out_nis, out_cov, out_bv, out_md = out
+    (out_q, out_b, out_a, out_ab, out_idx, out_flags, out_nis, out_sig, out_cov, out_bv,
+     out_md) = out
     # the estimate: attitude, gyro bias, manoeuvre acceleration, accelerometer bias,
     # covariance, and the outputs of the last `lag` epochs (the sliding bases; with
     # lag 1 the row is q itself)
@@ -1193,11 +1198,18 @@ def ekf_kernel(sensors, prop, window, params, init, out):
             out_q[k, i] = q[i]
         for a in range(3):
             out_b[k, a] = bias[a]
-            out_a[k, a] = accel[a]
-            out_ab[k, a] = acc_bias[a]
-            out_bv[k, a] = P[3 + a, 3 + a]
-            for c in range(3):
-                out_cov[k, a, c] = P[a, c]
+            out_sig[k, a] = np.sqrt(max(P[a, a], 0.0))
+        if singer:
+            for a in range(3):
+                out_a[k, a] = accel[a]
+        if nx > (9 if singer else 6):
+            for a in range(3):
+                out_ab[k, a] = acc_bias[a]
+        if params.store_covariance:
+            for a in range(3):
+                out_bv[k, a] = P[3 + a, 3 + a]
+                for c in range(3):
+                    out_cov[k, a, c] = P[a, c]
         out_idx[step] = k
         out_md[k] = delay
         out_flags[k] = flags

@@ -547,7 +547,7 @@ def _derived(cfg: AhrsConfig, ref, use_mag: bool, h: float, te: float) -> dict:
             "mag_ref_k": 1.0 - math.exp(-te / cfg.mag_reference_s),
             "mag_delay": round(cfg.mag_delay_s / h),
             "mag_delay_max": max(round(cfg.mag_delay_max_s / h), round(cfg.mag_delay_s / h)),
-            "mag_delay_alpha": min(1.0, h / cfg.mag_delay_tau_s)}
+            "mag_delay_alpha": min(1.0, h / cfg.mag_delay_tau_s), "store_covariance": False}
 
 
 def _params(cfg: AhrsConfig, ref, use_mag: bool, h: float, te: float) -> K.Params:
@@ -596,14 +596,16 @@ def _run(rec, acc, mag, prop: K.Propagation, window: K.Window, params: K.Params,
     h = rec.td
     x = rec.omega if prop.is_rate else 0.5 * h * (rec.omega[1:] + rec.omega[:-1])
     n = rec.t.size
+    nc = n if params.store_covariance else 1
     out = K.Outputs(q=np.empty((n, 4)), gyro_bias=np.empty((n, 3)), accel=np.zeros((n, 3)),
                     acc_bias=np.zeros((n, 3)), sample=np.empty(n, np.int64),
                     flags=np.zeros(n, np.int64), nis=np.empty((n, 2)),
-                    attitude_cov=np.empty((n, 3, 3)),
-                    bias_var=np.empty((n, 3)), mag_delay=np.zeros(n, np.int64))
+                    attitude_sigma=np.empty((n, 3)), attitude_cov=np.empty((nc, 3, 3)),
+                    bias_var=np.empty((nc, 3)), mag_delay=np.zeros(n, np.int64))
     out.q[0] = init.q
     out.gyro_bias[0] = init.gyro_bias
     out.nis[0] = np.nan
+    out.attitude_sigma[0] = np.sqrt(np.diag(init.P)[:3])
     out.attitude_cov[0] = init.P[:3, :3]
     out.bias_var[0] = np.diag(init.P)[3:6]
     out.mag_delay[0] = params.mag_delay
@@ -640,8 +642,8 @@ def _fill(rec, out: K.Outputs, k: int) -> np.ndarray:
     held = np.flatnonzero(~epoch[1:]) + 1  # rows that are neither epochs nor row 0
     if held.size:
         last = np.maximum.accumulate(np.where(epoch, np.arange(n), 0))  # last epoch row
-        for a in (out.gyro_bias, out.accel, out.acc_bias, out.attitude_cov, out.bias_var,
-                  out.mag_delay):
+        for a in (out.gyro_bias, out.accel, out.acc_bias, out.attitude_sigma, out.mag_delay,
+                  *((out.attitude_cov, out.bias_var) if out.bias_var.shape[0] == n else ())):
             a[held] = a[last[held]]
         out.nis[held] = np.nan
         _fill_between_epochs(rec, out.q, out.gyro_bias, last)
@@ -654,7 +656,6 @@ def _result(rec, out: K.Outputs, epoch, frame: str, have_mag: bool, algorithm: s
     attitudes after the initial one predicted over half a sample period
     (``gyro_sample="interval"``) plus ``latency_s``, then turned into ``frame``."""
     q, bias = out.q, out.gyro_bias
-    sigma = np.sqrt(np.maximum(np.diagonal(out.attitude_cov, axis1=1, axis2=2), 0.0))
     lead = cfg.latency_s + (0.5 * rec.td if cfg.gyro_sample == "interval" else 0.0)
     if lead > 0:  # predict each attitude but the initial one over the latency (causal)
         q = np.empty_like(out.q)
@@ -662,7 +663,7 @@ def _result(rec, out: K.Outputs, epoch, frame: str, have_mag: bool, algorithm: s
     if frame == "NED":
         q = quat_multiply(Q_NED_ENU, q)
     return AhrsResult(rec.t, np.arange(rec.t.size), epoch, q, frame, have_mag, bias,
-                      out.accel, out.flags, out.nis, sigma, algorithm, cfg,
+                      out.accel, out.flags, out.nis, out.attitude_sigma, algorithm, cfg,
                       out.acc_bias if cfg.estimate_acc_bias else None,
                       out.mag_delay * rec.td if have_mag else None, smoothed)
 
@@ -679,11 +680,13 @@ def _setup(t, gyro, acc, mag, cfg: AhrsConfig, q0, gyro_bias0, mag_reference, fr
 
 
 def _filter(rec, acc, mag, have_mag: bool, cfg: AhrsConfig, algorithm: str, q_init, b0,
-            ref):
-    """One causal pass: the completed per-sample outputs (ENU) and the epoch mask."""
+            ref, store_covariance: bool = False):
+    """One causal pass: the completed per-sample outputs (ENU; with the attitude and bias
+    covariances when ``store_covariance``) and the epoch mask."""
     prop, window = _propagation(_algorithm(algorithm))
     init = K.Initial(q_init, b0, _initial_covariance(cfg))
-    params = _params(cfg, ref, have_mag, rec.td, prop.stride * rec.td)
+    params = _params(cfg, ref, have_mag, rec.td, prop.stride * rec.td)._replace(
+        store_covariance=store_covariance)
     out, k = _run(rec, acc, mag, prop, window, params, init)
     return out, _fill(rec, out, k)
 
@@ -750,10 +753,10 @@ def _backward(rec, acc, mag, have_mag: bool, cfg: AhrsConfig, algorithm: str, fw
     rec_b = replace(rec, omega=np.ascontiguousarray(-rec.omega[::-1]))
     cfg_b = replace(cfg, estimate_mag_delay=False, mag_delay_s=0.0)
     out, epoch = _filter(rec_b, np.ascontiguousarray(acc[::-1]), np.ascontiguousarray(mag_b),
-                         have_mag, cfg_b, algorithm, fwd.q[-1], -fwd.gyro_bias[-1], ref)
+                         have_mag, cfg_b, algorithm, fwd.q[-1], -fwd.gyro_bias[-1], ref, True)
     rev = np.arange(n)[::-1]
-    for f in ("q", "gyro_bias", "accel", "acc_bias", "flags", "nis", "attitude_cov",
-              "bias_var"):
+    for f in ("q", "gyro_bias", "accel", "acc_bias", "flags", "nis", "attitude_sigma",
+              "attitude_cov", "bias_var"):
         getattr(out, f)[:] = getattr(out, f)[rev]
     out.gyro_bias[:] *= -1.0
     return out, epoch[rev]
@@ -772,6 +775,8 @@ def _combine(fwd, bwd) -> None:
     g = np.linalg.solve(pf + pb, pf).transpose(0, 2, 1)  # P_f (P_f + P_b)⁻¹ (symmetric P)
     fwd.q[:] = quat_multiply(fwd.q, quat_from_rotvec(np.einsum("nij,nj->ni", g, delta)))
     fwd.attitude_cov[:] = pf - g @ pf
+    fwd.attitude_sigma[:] = np.sqrt(np.maximum(np.diagonal(fwd.attitude_cov, axis1=1,
+                                                           axis2=2), 0.0))
     wf, wb = 1.0 / fwd.bias_var, 1.0 / bwd.bias_var
     fwd.gyro_bias[:] = (wf * fwd.gyro_bias + wb * bwd.gyro_bias) / (wf + wb)
     fwd.bias_var[:] = 1.0 / (wf + wb)
@@ -801,7 +806,7 @@ def offline_ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
     cfg = config or AhrsConfig()
     rec, acc, mag, have_mag, q_init, b0, ref = _setup(t, gyro, acc, mag, cfg, q0, gyro_bias0,
                                                        mag_reference, frame)
-    fwd, epoch = _filter(rec, acc, mag, have_mag, cfg, algorithm, q_init, b0, ref)
+    fwd, epoch = _filter(rec, acc, mag, have_mag, cfg, algorithm, q_init, b0, ref, True)
     bwd, _ = _backward(rec, acc, mag, have_mag, cfg, algorithm, fwd, ref)
     _combine(fwd, bwd)
     return _result(rec, fwd, epoch, frame, have_mag, algorithm, cfg, smoothed=True)
