@@ -105,7 +105,7 @@ def test_killed_sweep_process_resumes(tmp_path):
     assert 3 <= done < 24, "the sweep finished before it could be killed"
     # SIGKILL can leave a hidden temp file, never a half-written case under its final name
     finished = [f for f in (out / "cases").glob("*.json") if not f.name.startswith(".")]
-    assert all(json.loads(f.read_text())["row"] for f in finished)
+    assert all(json.loads(f.read_text())["metrics"] for f in finished)
     res = sweep(scn, out, workers=2)
     assert not list((out / "cases").glob(".*"))  # the rerun removed the killed run's temp files
     assert (res.skipped, res.computed) == (done, 24 - done)

@@ -84,3 +84,63 @@ def test_help_lists_every_exit_status(capsys):
               line.split()[0].isdigit()]
     assert listed == list(EXIT_STATUS) == sorted(EXIT_STATUS)
     assert {0, 2, 3, 74, 130} <= set(EXIT_STATUS)
+
+
+def _log(tmp_path):
+    import numpy as np
+
+    t = np.arange(100) * 1e-3
+    path = tmp_path / "a.npy"
+    np.save(path, np.column_stack([t, np.full(100, 0.5), np.zeros(100), np.zeros(100)]))
+    return str(path)
+
+
+@pytest.mark.parametrize(("out", "reason"), [
+    ("outdir.csv", "outdir.csv: Is a directory"),
+    ("afile/x.csv", "afile: Not a directory (a file, where the output directory should be)"),
+])
+def test_output_path_errors_are_one_line_with_status_74(tmp_path, capsys, out, reason):
+    (tmp_path / "outdir.csv").mkdir()
+    (tmp_path / "afile").write_text("")
+    code, err = _exit(capsys, "run", "--imu", _log(tmp_path), "--rates", "--units", "rad/s",
+                      "--out", str(tmp_path / out))
+    assert code == 74 and err.strip().endswith(reason) and len(err.strip().splitlines()) == 1
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.npy", "afile", "outdir.csv"]
+    assert not list((tmp_path / "outdir.csv").iterdir())
+
+
+def test_unwritable_output_directory_is_status_74(tmp_path, capsys, monkeypatch):
+    import tempfile
+
+    def refuse(*, prefix, suffix, dir):
+        raise PermissionError(13, "Permission denied", dir)
+
+    log = _log(tmp_path)
+    monkeypatch.setattr(tempfile, "mkstemp", refuse)  # as a read-only directory does
+    code, err = _exit(capsys, "run", "--imu", log, "--rates", "--units", "rad/s", "--out",
+                      str(tmp_path / "ro" / "x.csv"))
+    assert code == 74 and err.strip().endswith("x.csv.meta.json: Permission denied")
+
+
+def test_unreadable_input_is_status_74_naming_it(tmp_path, capsys, monkeypatch):
+    import builtins
+
+    log = _log(tmp_path)
+    real_open = builtins.open
+
+    def guarded(file, *args, **kwargs):
+        if str(file) == log:
+            raise PermissionError(13, "Permission denied", log)
+        return real_open(file, *args, **kwargs)
+
+    monkeypatch.setattr(builtins, "open", guarded)
+    code, err = _exit(capsys, "run", "--imu", log, "--rates", "--units", "rad/s", "--out",
+                      str(tmp_path / "x.csv"))
+    assert (code, err) == (74, f"strapdown run: error: {log}: Permission denied\n")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.npy"]
+
+
+def test_an_input_directory_is_bad_input(tmp_path, capsys):
+    code, err = _exit(capsys, "run", "--imu", str(tmp_path), "--rates", "--units", "rad/s",
+                      "--out", str(tmp_path / "x.csv"))
+    assert code == 2 and "is a directory; expected a log file" in err

@@ -16,6 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from strapdown import analysis
+from strapdown._core.errors import InputError
 from strapdown._core.kinds import InputKind
 from strapdown._core.validation import positive, positive_int
 from strapdown.algorithms.coning import CoefficientSet
@@ -32,8 +33,8 @@ from strapdown.analysis.law import LawResolution, judge_law
 from strapdown.truth import sensors
 from strapdown.truth.motions import ClassicalConing, KrylovMotion, Motion, PureSpin, SpinConing
 
-__all__ = ["METRICS", "MOTIONS", "Evaluation", "EvaluationConfig", "MetricName", "MotionName",
-           "build_motion", "evaluate"]
+__all__ = ["MAX_SAMPLES", "METRICS", "MOTIONS", "Evaluation", "EvaluationConfig", "MetricName",
+           "MotionName", "build_motion", "evaluate"]
 
 #: The reference motions an evaluation runs on (see :func:`build_motion`).
 MotionName = Literal["coning", "spin", "spin-coning", "krylov"]
@@ -46,6 +47,9 @@ MetricName = Literal["max_error_rad", "rms_error_rad", "cone_axis_drift_rad_s",
                      "drift_points", "measured_over_law", "law_status"]
 METRICS: tuple[MetricName, ...] = get_args(MetricName)
 RATE_ALGORITHMS = algorithms_taking("rate")
+#: Most samples (or computation steps) one evaluation simulates: 10⁸ increments take
+#: 2.4 GB as float64 with their truth.
+MAX_SAMPLES = 1e8
 
 
 @dataclass(frozen=True)
@@ -102,6 +106,31 @@ class EvaluationConfig:
         positive(self.sample_rate_hz, "sample rate (Hz)")
         positive(self.duration, "duration (s)")
         self._validate_motion()
+        self._validate_limits()
+
+    def _validate_limits(self) -> None:
+        """Sizes and rates the simulation can represent (checked before anything is
+        allocated): at most :data:`MAX_SAMPLES` samples (or steps), and no motion rate that
+        turns the body by more than π in one sample (beyond Nyquist nothing is resolved)."""
+        n = self.duration * self.sample_rate_hz
+        if self.step is not None:
+            positive(self.step, "step (s)")
+            n = max(n, self.duration / self.step)
+        if not n <= MAX_SAMPLES:
+            raise InputError(f"duration {self.duration:g} s at {self.sample_rate_hz:g} Hz gives "
+                             f"{n:.3g} samples; at most {MAX_SAMPLES:.0e} per evaluation")
+        h = 1.0 / self.sample_rate_hz
+        rates = {"cone rate": 2 * math.pi * abs(self.cone_rate_hz),
+                 "spin rate": math.radians(abs(self.spin_rate_dps))}
+        if self.motion == "krylov":
+            rates = {"krylov rate": max(abs(float(k)) for k in self.krylov_rates)}
+        for what, w in rates.items():
+            if not w * h <= math.pi:
+                raise InputError(f"the {what} turns {w * h:.3g} rad in one sample at "
+                                 f"{self.sample_rate_hz:g} Hz; at most π (Nyquist)")
+        if self.motion != "spin" and self.motion != "krylov" and not abs(
+                self.half_angle_deg) <= 180.0:
+            raise InputError(f"half angle must be within ±180°, got {self.half_angle_deg:g}")
 
     def _validate_motion(self) -> None:
         if self.motion == "krylov":

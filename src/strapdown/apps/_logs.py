@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from strapdown._core.errors import InputError
 from strapdown.algorithms.rate import UNIFORM_TOLERANCE, RateRecord, check_rate_record
 from strapdown.io.files import atomic_path
 from strapdown.io.readers import ImuLog, UnitAction
@@ -67,7 +68,7 @@ def rate_records(path: Path, log: ImuLog, *, split: bool, min_samples: int,
     if log.gaps and not split:
         r = log.gaps[0]
         gap = float(log.t[r - 1] - log.t[r - 2])
-        raise ValueError(f"{path}: {len(log.gaps)} gap(s), the first of {gap:.6g} s before data "
+        raise InputError(f"{path}: {len(log.gaps)} gap(s), the first of {gap:.6g} s before data "
                          f"row {r}; rate algorithms cannot bridge a gap: pass --on-gap split "
                          "(each gap-free segment on its own) or --on-gap error")
     cuts = log.segments() if split else [slice(0, log.t.size)]
@@ -78,7 +79,7 @@ def rate_records(path: Path, log: ImuLog, *, split: bool, min_samples: int,
                                           td=log.nominal_period, resample=resample))
         except ValueError as exc:
             where = f" segment {k} (data rows {c.start + 1}-{c.stop})" if split else ""
-            raise ValueError(f"{path}:{where} {exc}") from None
+            raise InputError(f"{path}:{where} {exc}") from None
     longest = max(recs, key=lambda r: r.t.size)
     return recs, JitterSummary(longest.td, max(r.jitter for r in recs),
                                any(r.resampled for r in recs), len(recs))
@@ -94,7 +95,7 @@ def log_segments(path: Path, log: ImuLog, *, split: bool, min_samples: int,
                                   resample=resample)
         return [ImuLog(r.t, r.omega, "rate", r.td, units=log.units) for r in recs], base
     if resample:
-        raise ValueError("--resample applies to rate logs (--rates) only")
+        raise InputError("--resample applies to rate logs (--rates) only")
     cuts = log.segments() if split else [slice(0, log.t.size)]
     return [ImuLog(log.t[c], log.data[c], "increment", log.h, units=log.units)
             for c in cuts], None
@@ -106,7 +107,7 @@ def check_finite(what: str, t: NDArray[np.float64], *arrays: NDArray[np.float64]
         bad = ~np.all(np.isfinite(a.reshape(a.shape[0], -1)), axis=1)
         if np.any(bad):
             i = int(np.argmax(bad))
-            raise ValueError(f"{what} is NaN or infinite from output row {i + 1} (t = "
+            raise InputError(f"{what} is NaN or infinite from output row {i + 1} (t = "
                              f"{float(t[i]):.6g} s); nothing written")
 
 

@@ -115,7 +115,8 @@ def _npy_chunks(path: Path, arr: NDArray[Any], units: GyroUnit, read: dict[str, 
         if np.any(bad):
             raise InputError(f"{path}: NaN or infinity in data row {s + int(np.argmax(bad)) + 1}")
         t = c[:, 0] if last is None else np.concatenate([[last], c[:, 0]])
-        d = np.diff(t)
+        with np.errstate(over="ignore", invalid="ignore"):  # an overflowing step is reported
+            d = np.diff(t)
         first = 1 if last is None else 0  # data row (1-based) of t[0] is s + first
         check_steps(path, d, t, s + first)
         if h is None and d.size:
@@ -167,8 +168,7 @@ def _spec(kind: InputKind, algorithm: AlgorithmName | None, structure: Structure
 def run_log(imu: str | os.PathLike[str], out: str | os.PathLike[str], *, kind: InputKind,
             units: GyroUnit | None, algorithm: AlgorithmName | None = None,
             structure: StructureName = "conventional", subsamples: int | None = None,
-            coefficients: CoefficientName | None = None,
-            columns: Sequence[str] | None = None,
+            coefficients: CoefficientName | None = None, columns: Sequence[str] | None = None,
             sample_rate_hz: float | None = None, angles: AngleOutput = "ypr",
             q0: ArrayLike | None = None, on_gap: RunGapPolicy = "report",
             gap_tolerance: float = 1.5, saturation: float | None = None,
@@ -320,7 +320,7 @@ def _run_increments(imu: Path, tmp: Path, read: dict[str, Any], spec: AlgorithmS
                     n_in += th.shape[0]
                     bar.update(th.shape[0])
                     if res.q.shape[0]:
-                        check_finite(f"the {spec} attitude", res.t, res.q)
+                        check_finite(f"{imu}: the {spec} attitude", res.t, res.q)
                         rows = _rows(res.t, res.q, angles)
                         if split:
                             rows = np.column_stack([rows, np.full(rows.shape[0], float(k))])
@@ -370,7 +370,7 @@ def _run_rates(imu: Path, tmp: Path, read: dict[str, Any], spec: AlgorithmSpec,
             q_last = sol.q[-1]
             bar.update(int(rec.t.size))
     t, q = np.concatenate(ts), np.concatenate(qs)
-    check_finite(f"the {spec} attitude", t, q)
+    check_finite(f"{imu}: the {spec} attitude", t, q)
     extra = _angles(q, angles)
     if split:
         extra["segment"] = np.concatenate(segs)

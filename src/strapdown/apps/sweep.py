@@ -25,14 +25,22 @@ to run (specs as in :mod:`strapdown.apps.compare`), the metrics to keep (keys of
     cone_rate_hz = [1.0, 2.0, 5.0]
     "gyro.white_noise" = [0.0, 1e-5]
 
-A *case* is one grid point with one algorithm. Cases are numbered grid-point
-major, algorithm minor. Each finished case is written at once, atomically, to
-``OUT/cases/<key>.json`` where the key is a hash of the case's full
-configuration; a rerun skips every case whose file exists, so a crash or
-Ctrl-C loses no finished case, and a changed scenario never reuses a stale
-result. When every case is done the tidy table — one row per case: ``case``,
-the grid parameters, ``algorithm``, the metrics — is written as
-``results.csv`` and ``results.parquet`` (pyarrow; the ``parquet`` extra).
+A *case* is one grid point with one algorithm; it is identified by its grid point
+(``case``, the grid parameters, ``algorithm``), and its result by its configuration.
+Cases are numbered grid-point major, algorithm minor. Each finished result is written at
+once, atomically, to ``OUT/cases/<key>.json`` where the key is a hash of the full
+configuration (the metrics only, no labels); a rerun skips every configuration whose file
+exists, so a crash or Ctrl-C loses no finished case, and a changed scenario never reuses a
+stale result. Cases with the same configuration — a repeated grid value, or a grid field
+the algorithm spec sets itself (``subsamples`` under ``rotvec:N=3``) — are computed once and
+each labelled with its own grid point. When every case is done the tidy table — one row per
+case: ``case``, the grid parameters, ``algorithm``, the metrics — is written as
+``results.csv`` and ``results.parquet`` (pyarrow; the ``parquet`` extra), the Parquet table
+built before anything is written.
+
+Every value of a scenario is checked for what its field takes, and every configuration
+before the first case runs (:func:`load_scenario`); anything wrong is an
+:class:`~strapdown.InputError`.
 A table with ``predicted_drift_rad_s`` also gets ``measured_over_law`` and
 ``law_status`` (resolved, below float64 floor, higher order in a dominates, gyro
 errors included: :mod:`strapdown.analysis.law`), so no ratio goes out without its
@@ -61,13 +69,14 @@ from typing import Literal, get_args
 
 import numpy as np
 
+from strapdown._core.errors import InputError, shown
 from strapdown.algorithms.spec import parse_spec
 from strapdown.analysis.evaluate import METRICS, EvaluationConfig, MetricName, evaluate
 from strapdown.io.files import atomic_path, csv_table, write_text
 from strapdown.truth.sensors import GyroErrors
 
 __all__ = ["FORMATS", "Case", "Scenario", "SweepInterrupted", "SweepResult", "TableFormat",
-           "cases", "load_scenario", "run_case", "sweep"]
+           "case_metrics", "case_row", "cases", "load_scenario", "run_case", "sweep"]
 
 # The metric names a scenario may ask for are the evaluation's (METRICS, MetricName: keys of
 # Evaluation.to_dict), defined in strapdown.analysis.evaluate.
@@ -127,110 +136,248 @@ def _jsonable(x):
 def _check_keys(where: str, got, allowed) -> None:
     bad = sorted(set(got) - set(allowed))
     if bad:
-        raise ValueError(f"{where}: unknown key(s) {bad}; allowed: {', '.join(sorted(allowed))}")
+        raise InputError(f"{where}: unknown key(s) {shown(bad, 120)}; allowed: "
+                         f"{', '.join(sorted(allowed))}")
 
 
-def load_scenario(path) -> Scenario:
-    """Parse and check a TOML scenario; errors name the file and the key."""
-    path = Path(path)
+#: Largest scenario file read (bytes).
+MAX_SCENARIO_BYTES = 1024**2
+#: Most cases (grid points × algorithms) one scenario may have.
+MAX_CASES = 100_000
+#: What each value of a scenario must be: the EvaluationConfig and GyroErrors fields.
+_KINDS = {"motion": "str", "half_angle_deg": "number", "cone_rate_hz": "number",
+          "spin_rate_dps": "number", "sample_rate_hz": "number", "duration": "number",
+          "subsamples": "int", "coefficients": "str", "structure": "str", "rk4_step": "str",
+          "krylov_rates": "triple", "alpha": "number", "beta": "number", "step": "number",
+          "exact_exp": "bool", "precision": "int",
+          "gyro.white_noise": "number", "gyro.bias": "vector", "gyro.gm_sigma": "vector",
+          "gyro.gm_tau": "number or inf", "gyro.scale_factor": "vector",
+          "gyro.misalignment": "matrix", "gyro.quantization": "number",
+          "gyro.saturation": "number or inf"}
+#: Largest arbitrary-precision digits a scenario may ask for.
+MAX_PRECISION = 10_000
+
+
+def _is_number(v, inf: bool = False) -> bool:
+    return (isinstance(v, (int, float)) and not isinstance(v, bool)
+            and (math.isfinite(v) or (inf and v == math.inf)))
+
+
+def _check_value(where: str, key: str, v) -> object:
+    """``v`` if it is what ``key`` takes (:data:`_KINDS`), as the configuration wants it
+    (lists of numbers as tuples for krylov_rates); else an InputError naming both."""
+    kind = _KINDS.get(key)
+    ok = {"str": lambda: isinstance(v, str),
+          "int": lambda: isinstance(v, int) and not isinstance(v, bool),
+          "bool": lambda: isinstance(v, bool),
+          "number": lambda: _is_number(v),
+          "number or inf": lambda: _is_number(v, inf=True),
+          "triple": lambda: isinstance(v, list) and len(v) == 3 and all(map(_is_number, v)),
+          "vector": lambda: _is_number(v) or (isinstance(v, list) and len(v) == 3
+                                              and all(map(_is_number, v))),
+          "matrix": lambda: isinstance(v, list) and len(v) == 3 and all(
+              isinstance(r, list) and len(r) == 3 and all(map(_is_number, r)) for r in v),
+          None: lambda: True}[kind]()
+    if key == "precision" and ok and not 0 < v <= MAX_PRECISION:
+        raise InputError(f"{where}: precision must be 1–{MAX_PRECISION} digits, got {v}")
+    if not ok:
+        what = {"number": "a finite number", "number or inf": "a number (inf allowed)",
+                "triple": "a list of three finite numbers", "matrix": "a 3×3 list of lists",
+                "vector": "a finite number or a list of three", "str": "a string",
+                "int": "an integer", "bool": "true or false"}[str(kind)]
+        raise InputError(f"{where}: {key} must be {what}, got {shown(v, 60)}")
+    return tuple(v) if kind == "triple" else v
+
+
+def _read_toml(path: Path) -> dict:
+    """The scenario file's TOML document; anything unreadable is an InputError."""
+    if path.is_dir():
+        raise InputError(f"{path}: is a directory; expected a scenario file (.toml)")
     if not path.is_file():
-        raise ValueError(f"{path}: no such scenario file")
+        raise InputError(f"{path}: no such scenario file")
+    size = path.stat().st_size
+    if size > MAX_SCENARIO_BYTES:
+        raise InputError(f"{path}: a scenario of {size} bytes (at most {MAX_SCENARIO_BYTES})")
     try:
-        doc = tomllib.loads(path.read_text(encoding="utf-8"))
+        return tomllib.loads(path.read_bytes().decode("utf-8"))
+    except UnicodeDecodeError as exc:
+        raise InputError(f"{path}: not UTF-8 text (byte {exc.start}); expected a TOML "
+                         "scenario") from None
     except tomllib.TOMLDecodeError as exc:
-        raise ValueError(f"{path}: not valid TOML ({exc})") from None
-    _check_keys(str(path), doc, _TOP)
+        raise InputError(f"{path}: not valid TOML ({shown(str(exc), 160)})") from None
+    except RecursionError:
+        raise InputError(f"{path}: nested too deeply to be a scenario") from None
+
+
+def _table(path: Path, doc: dict, key: str) -> dict:
+    part = doc.get(key, {})
+    if not isinstance(part, dict):
+        raise InputError(f"{path}: [{key}] must be a table, got {shown(part, 40)}")
+    return part
+
+
+def _strings(path: Path, doc: dict, key: str, default: list[str] | None) -> list[str]:
+    v = doc.get(key, default)
+    if not isinstance(v, list) or not v or not all(isinstance(a, str) for a in v):
+        raise InputError(f"{path}: '{key}' must be a non-empty list of strings, got "
+                         f"{shown(v, 60)}")
+    return list(v)
+
+
+def _base(path: Path, doc: dict) -> tuple[dict, dict]:
+    """The configuration fields of [motion], [sensor], [run] and the [gyro] table."""
     base: dict = {}
     for sec in _SECTIONS:
-        part = doc.get(sec, {})
-        if not isinstance(part, dict):
-            raise ValueError(f"{path}: [{sec}] must be a table")
+        part = _table(path, doc, sec)
         _check_keys(f"{path} [{sec}]", part, _CONFIG_FIELDS - {"algorithm"})
         dup = set(part) & set(base)
         if dup:
-            raise ValueError(f"{path}: {sorted(dup)} set in more than one section")
-        base.update(part)
-    if "krylov_rates" in base:
-        base["krylov_rates"] = tuple(base["krylov_rates"])
-    gyro = doc.get("gyro", {})
+            raise InputError(f"{path}: {sorted(dup)} set in more than one section")
+        base.update({k: _check_value(f"{path} [{sec}]", k, v) for k, v in part.items()})
+    gyro = _table(path, doc, "gyro")
     _check_keys(f"{path} [gyro]", gyro, _GYRO_FIELDS)
-    algorithms = doc.get("algorithms")
-    if not algorithms or not isinstance(algorithms, list):
-        raise ValueError(f"{path}: 'algorithms' must be a non-empty list of specs")
-    for a in algorithms:
-        parse_spec(a)
-    if len(set(algorithms)) != len(algorithms):
-        raise ValueError(f"{path}: an algorithm spec appears twice")
-    metrics = doc.get("metrics", list(DEFAULT_METRICS))
-    if not isinstance(metrics, list) or not metrics:
-        raise ValueError(f"{path}: 'metrics' must be a non-empty list")
-    if "predicted_drift_rad_s" in metrics:  # a law in the table comes with what it means
-        metrics += [m for m in LAW_COLUMNS if m not in metrics]
-    grid = doc.get("grid", {})
+    return base, {k: _check_value(f"{path} [gyro]", f"gyro.{k}", v) for k, v in gyro.items()}
+
+
+def _grid(path: Path, doc: dict, n_algorithms: int) -> dict:
+    """The [grid] table, every value checked for its field, its size bounded."""
+    grid = _table(path, doc, "grid")
+    points = 1
     for k, v in grid.items():
         if k.startswith("gyro."):
             _check_keys(f"{path} [grid]", [k[5:]], _GYRO_FIELDS)
         else:
             _check_keys(f"{path} [grid]", [k], _CONFIG_FIELDS - {"algorithm"})
         if not isinstance(v, list) or not v:
-            raise ValueError(f"{path}: grid '{k}' must be a non-empty list")
-    seed = doc.get("seed")
-    if seed is not None and (not isinstance(seed, int) or seed < 0):
-        raise ValueError(f"{path}: seed must be a non-negative integer, got {seed!r}")
-    scn = Scenario(base, gyro, tuple(algorithms), tuple(metrics), grid, seed)
-    all_cases = cases(scn)  # validates every configuration before anything runs
-    bad = [m for m in scn.metrics if m not in METRICS]
-    if bad:
-        raise ValueError(f"{path}: unknown metric(s) {bad}; choose from "
-                         f"{', '.join(sorted(METRICS))}")
-    if not all_cases:
-        raise ValueError(f"{path}: the grid is empty")
-    return scn
-
-
-def cases(scn: Scenario) -> list[Case]:
-    """Every case of a scenario, in table order (grid point major, algorithm minor)."""
-    keys = list(scn.grid)
-    out: list[Case] = []
-    points = list(itertools.product(*(scn.grid[k] for k in keys))) if keys else [()]
-    for p, values in enumerate(points):
-        params = dict(zip(keys, values, strict=True))
-        cfg_fields = dict(scn.base)
-        gyro = dict(scn.gyro)
-        for k, v in params.items():
-            if k.startswith("gyro."):
-                gyro[k[5:]] = v
-            else:
-                cfg_fields[k] = v
-        errors = GyroErrors(**gyro) if gyro else None
-        seed = None
-        if errors is not None and not errors.is_ideal:
-            if scn.seed is None:
-                raise ValueError("the scenario has random gyro errors; give a top-level seed")
-            seed = int(np.random.SeedSequence([scn.seed, p]).generate_state(1)[0])
-        for a in scn.algorithms:
-            cfg = EvaluationConfig(**{**cfg_fields, **parse_spec(a)}, gyro=errors, seed=seed)
-            try:
-                cfg.validate()
-                _ = cfg.samples
-            except ValueError as exc:
-                raise ValueError(f"case {len(out)} ({a}, {params}): {exc}") from None
-            out.append(Case(len(out), p, params, a, cfg, scn.metrics))
+            raise InputError(f"{path}: grid '{k}' must be a non-empty list")
+        points *= len(v)
+        if points * n_algorithms > MAX_CASES:
+            raise InputError(f"{path}: the grid has more than {MAX_CASES} cases (grid points × "
+                             "algorithms); split the scenario")
+    out = {k: [_check_value(f"{path} [grid] {k}", k, x) for x in v] for k, v in grid.items()}
+    for k, v in out.items():  # a table column holds one kind of value
+        kinds = {"number" if _is_number(x, inf=True) else type(x).__name__ for x in v}
+        if len(kinds) > 1:
+            raise InputError(f"{path}: grid '{k}' mixes {' and '.join(sorted(kinds))} values; "
+                             "a results column holds one kind")
     return out
 
 
-def run_case(case: Case) -> dict:
-    """Evaluate one case; returns its table row (JSON-ready). Picklable for workers."""
+def load_scenario(path) -> Scenario:
+    """Parse and check a TOML scenario; errors name the file and the key.
+
+    Every value is checked for what its field takes (a finite number, an integer, a
+    string, three numbers …) and every configuration of the grid is validated before
+    anything runs (:meth:`~strapdown.analysis.evaluate.EvaluationConfig.validate`: sample
+    counts up to :data:`~strapdown.analysis.evaluate.MAX_SAMPLES`, rates up to Nyquist);
+    the file is at most :data:`MAX_SCENARIO_BYTES`, the grid at most :data:`MAX_CASES` cases.
+    Anything wrong is an :class:`~strapdown.InputError`.
+    """
+    path = Path(path)
+    doc = _read_toml(path)
+    _check_keys(str(path), doc, _TOP)
+    base, gyro = _base(path, doc)
+    algorithms = _strings(path, doc, "algorithms", None)
+    for a in algorithms:
+        try:
+            parse_spec(a)
+        except ValueError as exc:
+            raise InputError(f"{path}: {exc}") from None
+    if len(set(algorithms)) != len(algorithms):
+        raise InputError(f"{path}: an algorithm spec appears twice")
+    metrics = _strings(path, doc, "metrics", list(DEFAULT_METRICS))
+    if "predicted_drift_rad_s" in metrics:  # a law in the table comes with what it means
+        metrics += [m for m in LAW_COLUMNS if m not in metrics]
+    bad = [m for m in metrics if m not in METRICS]
+    if bad:
+        raise InputError(f"{path}: unknown metric(s) {shown(bad, 80)}; choose from "
+                         f"{', '.join(sorted(METRICS))}")
+    grid = _grid(path, doc, len(algorithms))
+    seed = doc.get("seed")
+    if seed is not None and (not isinstance(seed, int) or isinstance(seed, bool) or seed < 0):
+        raise InputError(f"{path}: seed must be a non-negative integer, got {shown(seed, 30)}")
+    scn = Scenario(base, gyro, tuple(algorithms), tuple(metrics), grid, seed)
+    try:
+        cases(scn)  # validates every configuration before anything runs
+    except ValueError as exc:
+        raise InputError(f"{path}: {exc}") from None
+    return scn
+
+
+def _point_config(scn: Scenario, p: int, params: dict) -> tuple[dict, GyroErrors | None,
+                                                                   int | None]:
+    """Configuration fields, gyro errors and noise seed of grid point ``p``."""
+    cfg_fields = dict(scn.base)
+    gyro = dict(scn.gyro)
+    for k, v in params.items():
+        if k.startswith("gyro."):
+            gyro[k[5:]] = v
+        else:
+            cfg_fields[k] = v
+    try:
+        errors = GyroErrors(**gyro) if gyro else None
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"grid point {p} ({shown(params, 120)}): gyro: {exc}") from None
+    seed = None
+    if errors is not None and not errors.is_ideal:
+        if scn.seed is None:
+            raise InputError("the scenario has random gyro errors; give a top-level seed")
+        seed = int(np.random.SeedSequence([scn.seed, p]).generate_state(1)[0])
+    return cfg_fields, errors, seed
+
+
+def cases(scn: Scenario) -> list[Case]:
+    """Every case of a scenario, in table order (grid point major, algorithm minor).
+
+    Two cases may have the same configuration (a repeated grid value, or a grid field the
+    algorithm spec sets itself): they share one result (:attr:`Case.key`), computed once,
+    and each keeps its own grid point and labels in the table.
+    """
+    keys = list(scn.grid)
+    out: list[Case] = []
+    points = itertools.product(*(scn.grid[k] for k in keys)) if keys else iter([()])
+    for p, values in enumerate(points):
+        params = dict(zip(keys, values, strict=True))
+        cfg_fields, errors, seed = _point_config(scn, p, params)
+        for a in scn.algorithms:
+            try:
+                cfg = EvaluationConfig(**{**cfg_fields, **parse_spec(a)}, gyro=errors, seed=seed)
+                cfg.validate()
+                _ = cfg.samples
+            except (ValueError, TypeError, OverflowError, ArithmeticError) as exc:
+                raise InputError(f"case {len(out)} ({a}, {shown(params, 120)}): {exc}"
+                                 ) from None
+            out.append(Case(len(out), p, params, a, cfg, scn.metrics))
+    if not out:
+        raise InputError("the grid is empty")
+    return out
+
+
+def case_metrics(case: Case) -> dict:
+    """Evaluate one case's configuration; its metrics (JSON-ready), what the case store
+    keeps under :attr:`Case.key` — shared by every case with that configuration. Picklable
+    for workers."""
     d = evaluate(case.config).to_dict()
-    row = {"case": case.index, **case.params, "algorithm": case.algorithm}
+    out: dict = {}
     for m in case.metrics:
         v = d.get(m)
         if isinstance(v, (list, tuple)):
             for i, x in enumerate(v):
-                row[f"{m}[{i}]"] = _scalar(x)
+                out[f"{m}[{i}]"] = _scalar(x)
         else:
-            row[m] = _scalar(v)
-    return row
+            out[m] = _scalar(v)
+    return out
+
+
+def case_row(case: Case, metrics: dict) -> dict:
+    """The table row of ``case``: its own labels (case, grid point, algorithm), then the
+    metrics of its configuration."""
+    return {"case": case.index, **case.params, "algorithm": case.algorithm, **metrics}
+
+
+def run_case(case: Case) -> dict:
+    """Evaluate one case; returns its table row (JSON-ready)."""
+    return case_row(case, case_metrics(case))
 
 
 def _scalar(v):
@@ -278,9 +425,9 @@ def _parse_scheduler(scheduler: str) -> tuple[Literal["local", "dask"], str | No
     if scheduler.startswith("dask://"):
         addr = scheduler[len("dask://"):]
         if not addr or ":" not in addr:
-            raise ValueError(f"--scheduler {scheduler!r}: expected dask://HOST:PORT")
+            raise InputError(f"--scheduler {scheduler!r}: expected dask://HOST:PORT")
         return "dask", "tcp://" + addr
-    raise ValueError(f"--scheduler must be 'local' or 'dask://HOST:PORT', got {scheduler!r}")
+    raise InputError(f"--scheduler must be 'local' or 'dask://HOST:PORT', got {scheduler!r}")
 
 
 def sweep(scenario: str | os.PathLike[str] | Scenario, out: str | os.PathLike[str], *,
@@ -321,22 +468,24 @@ def sweep(scenario: str | os.PathLike[str] | Scenario, out: str | os.PathLike[st
     say = log or (lambda _m: None)
     out = Path(out)
     if out.exists() and not out.is_dir():
-        raise ValueError(f"{out} exists and is not a directory")
+        raise InputError(f"{out} exists and is not a directory")
     store = out / "cases"
     store.mkdir(parents=True, exist_ok=True)
     for stale in store.glob(".*.json.*"):  # temp files of a killed run (never a finished case)
         stale.unlink(missing_ok=True)
     all_cases = cases(scn)
-    pending = [c for c in all_cases if not (store / f"{c.key}.json").is_file()]
-    skipped = len(all_cases) - len(pending)
+    first = {c.key: c for c in reversed(all_cases)}  # each configuration's first case
+    stored = {k for k in first if (store / f"{k}.json").is_file()}
+    pending = [first[k] for k in dict.fromkeys(c.key for c in all_cases) if k not in stored]
+    skipped = sum(c.key in stored for c in all_cases)
     if max_cases is not None:
         pending = pending[:max_cases]
-    say(f"{len(all_cases)} cases: {skipped} already done, {len(pending)} to run "
+    shared = "" if len(first) == len(all_cases) else f" ({len(first)} distinct configurations)"
+    say(f"{len(all_cases)} cases{shared}: {skipped} already done, {len(pending)} to run "
         f"({'local pool' if kind == 'local' else address})")
 
-    def finish(case: Case, row: dict) -> None:
-        write_text(store / f"{case.key}.json", json.dumps(
-            {"key": case.key, "index": case.index, "row": row}))
+    def finish(case: Case, metrics: dict) -> None:
+        write_text(store / f"{case.key}.json", json.dumps({"key": case.key, "metrics": metrics}))
 
     from tqdm import tqdm
 
@@ -350,31 +499,39 @@ def sweep(scenario: str | os.PathLike[str] | Scenario, out: str | os.PathLike[st
     except KeyboardInterrupt:
         done = sum((store / f"{c.key}.json").is_file() for c in all_cases)
         raise SweepInterrupted(done, len(all_cases)) from None
-    done = sum((store / f"{c.key}.json").is_file() for c in all_cases)
-    if done < len(all_cases):
+    if not all((store / f"{k}.json").is_file() for k in first):
         return SweepResult(len(all_cases), skipped, len(pending), None, None)
-    rows = [json.loads((store / f"{c.key}.json").read_text(encoding="utf-8"))["row"]
-            for c in all_cases]
+    rows = [case_row(c, _stored(store / f"{c.key}.json", c)) for c in all_cases]
+    table = _arrow_table(rows) if "parquet" in formats else None  # fails before any write
     csv_path = _write_csv(out / "results.csv", rows)
-    pq = _write_parquet(out / "results.parquet", rows) if "parquet" in formats else None
+    pq = _write_parquet(out / "results.parquet", table) if table is not None else None
     return SweepResult(len(all_cases), skipped, len(pending), csv_path, pq)
 
 
+def _stored(path: Path, case: Case) -> dict:
+    """The metrics a case file holds (files of earlier versions held a labelled row)."""
+    data = json.loads(path.read_text(encoding="utf-8"))
+    if "metrics" in data:
+        return data["metrics"]
+    labels = {"case", "algorithm", *case.params}
+    return {k: v for k, v in data["row"].items() if k not in labels}
+
+
 def _check_options(formats: tuple, workers: int | None, max_cases: int | None) -> tuple:
-    """The table formats, once the sweep's options are checked (ValueError naming one)."""
+    """The table formats, once the sweep's options are checked (InputError naming one)."""
     bad = [f for f in formats if f not in FORMATS]
     if bad or not formats:
-        raise ValueError(f"formats must be a non-empty subset of csv, parquet; got {formats}")
+        raise InputError(f"formats must be a non-empty subset of csv, parquet; got {formats}")
     if "parquet" in formats:
         try:
             import pyarrow  # noqa: F401
         except ImportError:
-            raise ValueError("Parquet output needs pyarrow: pip install 'strapdown[parquet]', "
+            raise InputError("Parquet output needs pyarrow: pip install 'strapdown[parquet]', "
                              "or ask for --format csv") from None
     if workers is not None and workers < 1:
-        raise ValueError(f"workers must be at least 1, got {workers}")
+        raise InputError(f"workers must be at least 1, got {workers}")
     if max_cases is not None and max_cases < 0:
-        raise ValueError(f"max_cases must be non-negative, got {max_cases}")
+        raise InputError(f"max_cases must be non-negative, got {max_cases}")
     return formats
 
 
@@ -383,7 +540,7 @@ def _run_local(pending, workers, finish, bar) -> None:
         return
     if workers == 1:
         for c in pending:
-            finish(c, run_case(c))
+            finish(c, case_metrics(c))
             bar.update()
         return
     import multiprocessing
@@ -404,25 +561,25 @@ def _run_local(pending, workers, finish, bar) -> None:
 
 
 def _run_numbered(item: tuple[int, Case]) -> tuple[int, dict]:
-    """``(i, case)`` → ``(i, row)``: a pool result that names its case."""
+    """``(i, case)`` → ``(i, metrics)``: a pool result that names its case."""
     i, case = item
-    return i, run_case(case)
+    return i, case_metrics(case)
 
 
 def _run_dask(address, pending, finish, bar) -> None:
     try:
         from distributed import Client, as_completed
     except ImportError:
-        raise ValueError("--scheduler dask:// needs dask.distributed: "
+        raise InputError("--scheduler dask:// needs dask.distributed: "
                          "pip install 'strapdown[dask]'") from None
     if not pending:
         return
     try:
         client = Client(address, timeout="10s")
     except OSError as exc:
-        raise ValueError(f"cannot reach the Dask scheduler at {address}: {exc}") from None
+        raise InputError(f"cannot reach the Dask scheduler at {address}: {exc}") from None
     try:
-        futures = client.map(run_case, pending, pure=False)
+        futures = client.map(case_metrics, pending, pure=False)
         by_future = dict(zip(futures, pending, strict=True))
         for fut in as_completed(futures):
             finish(by_future[fut], fut.result())
@@ -450,12 +607,21 @@ def _write_csv(path: Path, rows) -> Path:
     return write_text(path, csv_table(cols, [[_text(r.get(c)) for c in cols] for r in rows]))
 
 
-def _write_parquet(path: Path, rows) -> Path:
+def _arrow_table(rows):
+    """The rows as a pyarrow table (an InputError when a column mixes types)."""
     import pyarrow as pa
-    import pyarrow.parquet as pq
 
     cols = _columns(rows)
-    table = pa.Table.from_pydict({c: [r.get(c) for r in rows] for c in cols})
+    try:
+        return pa.Table.from_pydict({c: [r.get(c) for r in rows] for c in cols})
+    except (pa.ArrowInvalid, pa.ArrowTypeError) as exc:
+        raise InputError(f"the results cannot be written as Parquet ({shown(str(exc), 160)}); "
+                         "nothing written") from None
+
+
+def _write_parquet(path: Path, table) -> Path:
+    import pyarrow.parquet as pq
+
     with atomic_path(path) as tmp:
         pq.write_table(table, tmp)
     return path

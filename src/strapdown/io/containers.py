@@ -249,6 +249,8 @@ def _npz_member(path: Path, zf: zipfile.ZipFile, info: zipfile.ZipInfo,
                 pos += n
             while f.read(_CHUNK):  # the rest, so that the CRC is checked
                 pass
+    except InputError:
+        raise
     except _ZIP_ERRORS as exc:
         raise InputError(f"{path}: {what} is unreadable ({shown(str(exc), 120)})") from None
     return arr.reshape(hdr.shape, order="F" if hdr.fortran else "C")

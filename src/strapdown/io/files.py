@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
 import tempfile
 from pathlib import Path
@@ -28,10 +29,16 @@ def atomic_path(path: str | os.PathLike):
 
     The file gets the mode a plain ``open(path, "w")`` would give it (0666 less the
     umask), not the 0600 of the private temporary file. An ``OSError`` about the temporary
-    file is raised as one about ``path`` (the name the user gave).
+    file is raised as one about ``path`` (the name the user gave); a regular file where a
+    directory of ``path`` should be is a ``NotADirectoryError`` naming that file.
     """
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+    except FileExistsError:  # a regular file where a directory of the path should be
+        blocker = next(p for p in path.parents if p.exists())
+        raise NotADirectoryError(errno.ENOTDIR, "Not a directory (a file, where the output "
+                                 "directory should be)", str(blocker)) from None
     try:
         fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=path.suffix, dir=path.parent)
     except OSError as exc:

@@ -418,7 +418,9 @@ def check_rows(path: str | os.PathLike[str], t: NDArray[np.float64],
             where = "" if label is None else f" the {label} at"
             raise InputError(f"{path}: NaN or infinity in{where} data row "
                              f"{int(np.argmax(bad)) + 1}")
-    check_steps(path, np.diff(t), t)
+    with np.errstate(over="ignore", invalid="ignore"):  # an overflowing step is reported
+        d = np.diff(t)
+    check_steps(path, d, t)
 
 
 def check_steps(path: str | os.PathLike[str], d: NDArray[np.float64], t: NDArray[np.float64],
@@ -429,11 +431,12 @@ def check_steps(path: str | os.PathLike[str], d: NDArray[np.float64], t: NDArray
     if fault is not None:
         i, what = fault
         raise InputError(f"{path}: {what} time stamp in data row {i + first_row + 1} (t = "
-                         f"{t[i + 1]!r} after {t[i]!r})")
+                         f"{float(t[i + 1])!r} after {float(t[i])!r})")
     bad = ~np.isfinite(d) | (d < MIN_PERIOD)
     if np.any(bad):
         i = int(np.argmax(bad))
-        raise InputError(f"{path}: time step of {d[i]!r} s before data row {i + first_row + 1}; "
+        raise InputError(f"{path}: time step of {float(d[i])!r} s before data row "
+                         f"{i + first_row + 1}; "
                          f"steps must be finite and at least {MIN_PERIOD:g} s (check the time "
                          "unit)")
 
@@ -511,8 +514,9 @@ def file_rate(path: str | os.PathLike[str], value: ArrayLike | None) -> float | 
         raise InputError(f"{path}: sampling_rate must be one number, got {a.dtype.name} of "
                          f"shape {a.shape}")
     fs = float(a.reshape(()))
-    if not (math.isfinite(fs) and fs > 0):
-        raise InputError(f"{path}: sampling_rate must be positive and finite, got {fs!r}")
+    if not 1 / MAX_PERIOD <= fs <= 1 / MIN_PERIOD:
+        raise InputError(f"{path}: sampling_rate must be positive and finite, between "
+                         f"{1 / MAX_PERIOD:g} and {1 / MIN_PERIOD:g} Hz, got {fs!r}")
     return fs
 
 
