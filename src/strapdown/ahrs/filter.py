@@ -125,6 +125,12 @@ class AhrsConfig:
         Noise density of the low-passed horizontal specific force, m/s²/√Hz (CV).
     acc_gate_lowpass : float
         NIS gate of the low-passed measurement (χ², 2 dof, 99.9 %: 13.82).
+    acc_lowpass_norm_tol : float
+        The low-passed measurement is skipped (``ACC_DISTURBED``) when its norm departs
+        from gravity's — as measured over ``init_window_s`` — by more than this fraction:
+        a sustained acceleration, such as a coordinated turn's, does not average out
+        (a horizontal one of a g lengthens it by ≈ a²/2: 1.5 % at 0.17 g, a 10° bank).
+        Default 0.015 — physical, not tuned: BROAD's handheld motions never reach it.
     acc_gate_mode : {"hard", "soft"}
         Beyond the gate: reject (hard, default) or de-weight (soft, Huber-type).
     lever_arm : float
@@ -246,6 +252,7 @@ class AhrsConfig:
     acc_lowpass_s: float = 2.1
     acc_lowpass_noise: float = 0.036
     acc_gate_lowpass: float = 13.82
+    acc_lowpass_norm_tol: float = 0.015
     acc_gate_mode: str = "hard"
     lever_arm: float = 0.1
     acc_norm_tol: float = 0.25
@@ -529,7 +536,8 @@ def butterworth(tau: float, ts: float) -> tuple[float, float, float, float, floa
     return b0, 2.0 * b0, b0, 2.0 * (c * c - 1.0) / d, (1.0 - math.sqrt(2.0) * c + c * c) / d
 
 
-def _derived(cfg: AhrsConfig, ref, use_mag: bool, h: float, te: float) -> dict:
+def _derived(cfg: AhrsConfig, ref, use_mag: bool, h: float, te: float,
+             g_measured: float) -> dict:
     """The kernel parameters that are not config fields of the same name: the reference
     field ``ref`` (norm, dip, heading), the switches, and what depends on the epoch
     period ``te`` — the low-pass coefficients and averaging counts, the reference's
@@ -547,17 +555,19 @@ def _derived(cfg: AhrsConfig, ref, use_mag: bool, h: float, te: float) -> dict:
             "mag_ref_k": 1.0 - math.exp(-te / cfg.mag_reference_s),
             "mag_delay": round(cfg.mag_delay_s / h),
             "mag_delay_max": max(round(cfg.mag_delay_max_s / h), round(cfg.mag_delay_s / h)),
-            "mag_delay_alpha": min(1.0, h / cfg.mag_delay_tau_s), "store_covariance": False}
+            "mag_delay_alpha": min(1.0, h / cfg.mag_delay_tau_s), "store_covariance": False,
+            "gravity_measured": g_measured}
 
 
-def _params(cfg: AhrsConfig, ref, use_mag: bool, h: float, te: float) -> K.Params:
+def _params(cfg: AhrsConfig, ref, use_mag: bool, h: float, te: float,
+            g_measured: float) -> K.Params:
     """The kernel's parameter record: the config's fields of the same name and
     :func:`_derived`'s for the sample period ``h`` and the epoch period ``te``.
 
     Every value is converted to its field's type (float, int or bool), so the
     compiled kernel's signature — and numba's cache entry — never changes.
     """
-    derived = _derived(cfg, ref, use_mag, h, te)
+    derived = _derived(cfg, ref, use_mag, h, te, g_measured)
     types = typing.get_type_hints(K.Params)
     return K.Params(**{f: types[f](derived[f] if f in derived else getattr(cfg, f))
                        for f in K.Params._fields})
@@ -668,6 +678,12 @@ def _result(rec, out: K.Outputs, epoch, frame: str, have_mag: bool, algorithm: s
                       out.mag_delay * rec.td if have_mag else None, smoothed)
 
 
+def _gravity_measured(rec, acc, cfg: AhrsConfig) -> float:
+    """The specific force's norm over the initial window (assumed at rest): gravity as
+    this accelerometer measures it, scale error included."""
+    return float(np.linalg.norm(acc[:_init_window(rec, cfg)].mean(axis=0)))
+
+
 def _setup(t, gyro, acc, mag, cfg: AhrsConfig, q0, gyro_bias0, mag_reference, frame):
     """Validated record and initial state: (rec, acc, mag, have_mag, q_init (ENU), b0,
     reference field (norm, dip, heading))."""
@@ -680,12 +696,13 @@ def _setup(t, gyro, acc, mag, cfg: AhrsConfig, q0, gyro_bias0, mag_reference, fr
 
 
 def _filter(rec, acc, mag, have_mag: bool, cfg: AhrsConfig, algorithm: str, q_init, b0,
-            ref, store_covariance: bool = False):
+            ref, g_measured: float, store_covariance: bool = False):
     """One causal pass: the completed per-sample outputs (ENU; with the attitude and bias
-    covariances when ``store_covariance``) and the epoch mask."""
+    covariances when ``store_covariance``) and the epoch mask. ``g_measured``: gravity's
+    norm as the accelerometer measures it (:func:`_gravity_measured`)."""
     prop, window = _propagation(_algorithm(algorithm))
     init = K.Initial(q_init, b0, _initial_covariance(cfg))
-    params = _params(cfg, ref, have_mag, rec.td, prop.stride * rec.td)._replace(
+    params = _params(cfg, ref, have_mag, rec.td, prop.stride * rec.td, g_measured)._replace(
         store_covariance=store_covariance)
     out, k = _run(rec, acc, mag, prop, window, params, init)
     return out, _fill(rec, out, k)
@@ -736,11 +753,13 @@ def ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
     cfg = config or AhrsConfig()
     rec, acc, mag, have_mag, q_init, b0, ref = _setup(t, gyro, acc, mag, cfg, q0, gyro_bias0,
                                                        mag_reference, frame)
-    out, epoch = _filter(rec, acc, mag, have_mag, cfg, algorithm, q_init, b0, ref)
+    out, epoch = _filter(rec, acc, mag, have_mag, cfg, algorithm, q_init, b0, ref,
+                         _gravity_measured(rec, acc, cfg))
     return _result(rec, out, epoch, frame, have_mag, algorithm, cfg)
 
 
-def _backward(rec, acc, mag, have_mag: bool, cfg: AhrsConfig, algorithm: str, fwd, ref):
+def _backward(rec, acc, mag, have_mag: bool, cfg: AhrsConfig, algorithm: str, fwd, ref,
+              g_measured: float):
     """The same filter over the time-reversed record (gyro negated), started from the
     forward pass's last attitude and bias and with its reference field; the
     magnetometer, which leads in reversed time, advanced by the forward pass's median
@@ -753,7 +772,8 @@ def _backward(rec, acc, mag, have_mag: bool, cfg: AhrsConfig, algorithm: str, fw
     rec_b = replace(rec, omega=np.ascontiguousarray(-rec.omega[::-1]))
     cfg_b = replace(cfg, estimate_mag_delay=False, mag_delay_s=0.0)
     out, epoch = _filter(rec_b, np.ascontiguousarray(acc[::-1]), np.ascontiguousarray(mag_b),
-                         have_mag, cfg_b, algorithm, fwd.q[-1], -fwd.gyro_bias[-1], ref, True)
+                         have_mag, cfg_b, algorithm, fwd.q[-1], -fwd.gyro_bias[-1], ref,
+                         g_measured, True)
     rev = np.arange(n)[::-1]
     for f in ("q", "gyro_bias", "accel", "acc_bias", "flags", "nis", "attitude_sigma",
               "attitude_cov", "bias_var"):
@@ -806,7 +826,8 @@ def offline_ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
     cfg = config or AhrsConfig()
     rec, acc, mag, have_mag, q_init, b0, ref = _setup(t, gyro, acc, mag, cfg, q0, gyro_bias0,
                                                        mag_reference, frame)
-    fwd, epoch = _filter(rec, acc, mag, have_mag, cfg, algorithm, q_init, b0, ref, True)
-    bwd, _ = _backward(rec, acc, mag, have_mag, cfg, algorithm, fwd, ref)
+    g = _gravity_measured(rec, acc, cfg)
+    fwd, epoch = _filter(rec, acc, mag, have_mag, cfg, algorithm, q_init, b0, ref, g, True)
+    bwd, _ = _backward(rec, acc, mag, have_mag, cfg, algorithm, fwd, ref, g)
     _combine(fwd, bwd)
     return _result(rec, fwd, epoch, frame, have_mag, algorithm, cfg, smoothed=True)
