@@ -18,6 +18,6 @@ def sinc(x: ArrayLike) -> NDArray[np.float64]:
     x = np.asarray(x, dtype=np.float64)
     small = np.abs(x) < SMALL_ANGLE
     xs = np.where(small, 1.0, x)
-    x2 = x * x
+    x2 = np.where(small, x, 0.0) ** 2  # the series only where it is used (no overflow)
     series = 1.0 - x2 / 6.0 * (1.0 - x2 / 20.0 * (1.0 - x2 / 42.0))
     return np.where(small, series, np.sin(xs) / xs)

@@ -52,8 +52,7 @@ def as_vectors(x: ArrayLike, name: str = "vector") -> NDArray[np.float64]:
 def as_quaternions(x: ArrayLike, name: str = "quaternion") -> NDArray[np.float64]:
     """Scalar-first quaternions, shape ``(..., 4)``; non-zero norm required."""
     q = _trailing(x, name, (4,), "scalar-first quaternions")
-    n = np.linalg.norm(q, axis=-1)
-    if np.any(n == 0.0):
+    if np.any(np.all(q == 0.0, axis=-1)):  # not the norm: it underflows below 1e-154
         raise ValueError(f"{name} contains a zero quaternion")
     return q
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from strapdown._core.scaling import safe_unit
 from strapdown._core.validation import as_dcms, as_quaternions
 
 __all__ = ["dcm_from_quat", "quat_from_dcm"]
@@ -12,8 +13,7 @@ __all__ = ["dcm_from_quat", "quat_from_dcm"]
 
 def dcm_from_quat(q: ArrayLike) -> NDArray[np.float64]:
     """``C_n_b`` from ``q_n_b`` (normalised first), shape ``(..., 3, 3)``."""
-    u = as_quaternions(q, "q")
-    u = u / np.linalg.norm(u, axis=-1, keepdims=True)
+    u = safe_unit(as_quaternions(q, "q"))
     w, x, y, z = np.moveaxis(u, -1, 0)
     return np.stack(
         [

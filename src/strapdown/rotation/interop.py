@@ -6,6 +6,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
+from strapdown._core.scaling import pow2_exponent
 from strapdown._core.validation import as_quaternions
 
 __all__ = ["quat_from_scipy", "scipy_from_quat"]
@@ -16,7 +17,8 @@ def scipy_from_quat(q: ArrayLike) -> Rotation:
     q = as_quaternions(q, "q")
     if q.ndim > 2:
         raise ValueError(f"q must have shape (4,) or (n, 4) for scipy, got shape {q.shape}")
-    return Rotation.from_quat(q, scalar_first=True)
+    # a power-of-two scale first (unit quaternions unchanged): scipy's norm cannot overflow
+    return Rotation.from_quat(np.ldexp(q, -pow2_exponent(q)), scalar_first=True)
 
 
 def quat_from_scipy(rotation: Rotation) -> NDArray[np.float64]:

@@ -8,6 +8,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from strapdown._core.scaling import pow2_exponent, safe_norm, safe_unit
 from strapdown._core.series import SMALL_ANGLE, sinc
 from strapdown._core.validation import as_quaternions, as_vectors
 
@@ -54,9 +55,9 @@ def quat_conjugate(q: ArrayLike) -> NDArray[np.float64]:
 
 
 def quat_normalize(q: ArrayLike) -> NDArray[np.float64]:
-    """Unit quaternion with the same attitude."""
-    q = as_quaternions(q, "q")
-    return q / np.linalg.norm(q, axis=-1, keepdims=True)
+    """Unit quaternion with the same attitude, for any non-zero finite ``q`` (scaled by a
+    power of two first: :func:`strapdown._core.scaling.safe_unit`)."""
+    return safe_unit(as_quaternions(q, "q"))
 
 
 def quat_canonical(q: ArrayLike) -> NDArray[np.float64]:
@@ -83,10 +84,12 @@ def quat_rotate(q: ArrayLike, v: ArrayLike) -> NDArray[np.float64]:
     """
     q = quat_normalize(q)
     v = as_vectors(v, "v")
+    e = pow2_exponent(v)  # rotation is linear: scale v by a power of two, then back
+    v = np.ldexp(v, -e)
     w = q[..., :1]
     u = q[..., 1:]
     t = 2.0 * np.cross(u, v)
-    return v + w * t + np.cross(u, t)
+    return np.ldexp(v + w * t + np.cross(u, t), e)
 
 
 def quat_from_rotvec(rotvec: ArrayLike) -> NDArray[np.float64]:
@@ -97,11 +100,15 @@ def quat_from_rotvec(rotvec: ArrayLike) -> NDArray[np.float64]:
     quaternion form; conventions.md "Rotation vector").
     """
     phi = as_vectors(rotvec, "rotvec")
-    angle = np.linalg.norm(phi, axis=-1)
+    angle = safe_norm(phi)  # 1e308 rad has a norm; 1e-160 rad too
     half = 0.5 * angle
     w = np.cos(half)
     s = 0.5 * sinc(half)  # sin(|φ|/2) / |φ|
-    return np.concatenate([w[..., None], s[..., None] * phi], axis=-1)
+    # beyond 1e150 rad, sin(|φ|/2) times the axis (s·φ would lose digits to underflow)
+    huge = (angle > 1e150)[..., None]
+    v = np.where(huge, np.sin(half)[..., None] * safe_unit(np.where(huge, phi, 1.0)),
+                 s[..., None] * phi)
+    return np.concatenate([w[..., None], v], axis=-1)
 
 
 def rotvec_from_quat(q: ArrayLike) -> NDArray[np.float64]:
@@ -109,9 +116,10 @@ def rotvec_from_quat(q: ArrayLike) -> NDArray[np.float64]:
 
     Uses ``|φ| = 2 atan2(|v|, |w|)`` with the sign of ``w`` folded into the
     vector part, which is accurate near 0 and near π and insensitive to the
-    norm of ``q``.
+    norm of ``q`` (scaled by a power of two first, so 1e300 and 1e-300 work too).
     """
     q = as_quaternions(q, "q")
+    q = np.ldexp(q, -pow2_exponent(q))
     w = q[..., 0]
     v = q[..., 1:]
     sign = np.where(w < 0.0, -1.0, 1.0)
@@ -122,8 +130,8 @@ def rotvec_from_quat(q: ArrayLike) -> NDArray[np.float64]:
     # scale = angle / s = 2 atan(r)/(r w), r = s/w; for small r the series
     # 2/w (1 − r²/3 + r⁴/5 − r⁶/7 + r⁸/9), first omitted term r¹⁰/11 < 1e-21.
     small = s < SMALL_ANGLE * w
-    ws = np.where(w == 0.0, 1.0, w)
-    r2 = (s / ws) ** 2
+    ws = np.where(small, w, 1.0)  # the series only where it is used (w > 0 there): no
+    r2 = (s / ws) ** 2  # overflow from a tiny w on the other branch
     series = 2.0 / ws * (1.0 - r2 * (1.0 / 3.0 - r2 * (1.0 / 5.0 - r2 * (1.0 / 7.0
                                                                       - r2 / 9.0))))
     ss = np.where(s == 0.0, 1.0, s)

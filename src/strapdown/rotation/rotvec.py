@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from strapdown._core.scaling import safe_norm, safe_unit
 from strapdown._core.series import sinc
 from strapdown._core.validation import as_vectors
 
@@ -44,7 +45,20 @@ def dcm_from_rotvec(rotvec: ArrayLike) -> NDArray[np.float64]:
     For an interval's body rotation vector this is ``C_b(k-1)_b(k)``.
     """
     phi = as_vectors(rotvec, "rotvec")
-    f1, f2 = f1_f2(np.linalg.norm(phi, axis=-1))
+    angle = safe_norm(phi)
+    if np.any(angle > 1e150):  # (φ×)² overflows: the same matrix from the unit axis
+        return _dcm_from_axis_angle(phi, angle)
+    f1, f2 = f1_f2(angle)
     k = skew(phi)
     eye = np.broadcast_to(np.eye(3), k.shape)
     return eye + f1[..., None, None] * k + f2[..., None, None] * (k @ k)
+
+
+def _dcm_from_axis_angle(phi: NDArray[np.float64], angle: NDArray[np.float64]
+                         ) -> NDArray[np.float64]:
+    """``I + sin a (n×) + (1 − cos a)(n×)²`` with ``n = φ/|φ|`` (a = 0: the identity)."""
+    zero = (angle == 0.0)[..., None]
+    k = skew(np.where(zero, 0.0, safe_unit(np.where(zero, 1.0, phi))))
+    eye = np.broadcast_to(np.eye(3), k.shape)
+    return (eye + np.sin(angle)[..., None, None] * k
+            + (1.0 - np.cos(angle))[..., None, None] * (k @ k))
