@@ -12,7 +12,8 @@ a small function that numba inlines into the loop (``inline="always"``):
 2. :func:`_fold_rest_samples` — the rest detector's moving averages;
 3. :func:`_propagate_covariance` and :func:`_add_process_noise` — ``P ← Φ P Φᵀ + Q``,
    with a tilt noise proportional to the rotation rate;
-4. :func:`_rest_detect` and :func:`_rest_model` — the zero-rate bias update;
+4. :func:`_rest_detect` and :func:`_rest_model` — the zero-rate bias update, once rest
+   has lasted ``rest_min_s``;
 5. the accelerometer: recovery (:func:`_acc_recovery`), then the model of
    ``AhrsConfig.acc_model`` — :func:`_acc_lowpass_model` (Laidig & Seel (2023),
    VQF's idea: the specific force in the almost-inertial reference frame through a
@@ -145,6 +146,8 @@ class Params(NamedTuple):
     recover_acc_s: float
     recover_mag_s: float
     rest_gyro: float
+    rest_gyro_mean: float
+    rest_min_s: float
     rest_acc: float
     rest_noise: float
     rest_tau: float
@@ -640,7 +643,7 @@ def _rest_detect(ema_n, rest_alpha, params, gm, g2, am, a2):
     acc_quiet = (settled and sacc < ra * ra
                  and abs(np.sqrt(am[0] ** 2 + am[1] ** 2 + am[2] ** 2) - params.gravity) < ra)
     rg = params.rest_gyro
-    at_rest = acc_quiet and sg < rg * rg and wm2 < 25.0 * rg * rg
+    at_rest = acc_quiet and sg < rg * rg and wm2 < params.rest_gyro_mean ** 2
     return acc_quiet, at_rest
 
 
@@ -1089,6 +1092,7 @@ def ekf_kernel(sensors, prop, window, params, init, out):
     ms[M_CNORM] = params.ref_norm
     ms[M_CDIP] = params.ref_dip
     ms[M_UNDIST] = params.mag_settle_s
+    rest_since = -1.0  # start of the current run of rest detections (−1: none)
     acc_bad_since = -1.0  # start of the current run of rejections (−1: none)
     mag_bad_since = -1.0
     e = 0
@@ -1122,7 +1126,8 @@ def ekf_kernel(sensors, prop, window, params, init, out):
         tk = k * h
         # stage 4: rest
         acc_quiet, at_rest = _rest_detect(ema_n, rest_alpha, params, gm, g2, am, a2)
-        if params.rest_update and at_rest:
+        rest_since = (rest_since if rest_since >= 0.0 else tk) if at_rest else -1.0
+        if params.rest_update and at_rest and tk - rest_since >= params.rest_min_s:
             _rest_model(params, bias, gm, dx, y3)
             _gated_update(P, H_rest, 6, params.rest_noise ** 2 / T, y3, 0.0, False, True, False,
                           dx, U3, S3, Si3)

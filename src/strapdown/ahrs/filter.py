@@ -205,8 +205,14 @@ class AhrsConfig:
         Standard deviation added on recovery, rad. Default 0.1.
     rest_gyro, rest_acc : float
         Rest when the gyro's standard deviation over ``rest_tau`` is below
-        ``rest_gyro`` (rad/s) and its mean below 5 × that, and the
-        accelerometer's below ``rest_acc`` (m/s²) (CV).
+        ``rest_gyro`` (rad/s), its mean below ``rest_gyro_mean``, and the
+        accelerometer's standard deviation below ``rest_acc`` (m/s²) (CV).
+    rest_gyro_mean : float
+        The largest gyro mean that can be a bias at rest, rad/s. Default 0.035 (2 °/s,
+        Laidig & Seel's biasClip): a slow steady rotation is not rest.
+    rest_min_s : float
+        Zero-rate updates start once rest has been detected this long, s (Laidig &
+        Seel's restMinT): one quiet sample at the start of a motion is not rest.
     rest_noise : float
         Noise density of the zero-rate bias measurement, rad/s/√Hz. Default 1.2e-4.
     rest_tau : float
@@ -274,6 +280,8 @@ class AhrsConfig:
     recover_mag_s: float = 10.0
     recover_angle: float = 0.1
     rest_gyro: float = 0.04
+    rest_gyro_mean: float = 0.035
+    rest_min_s: float = 0.5
     rest_acc: float = 0.2
     rest_noise: float = 1.2e-4
     rest_tau: float = 0.5
@@ -318,7 +326,7 @@ class AhrsConfig:
 
 #: AhrsConfig fields that may be negative, and those that may be zero.
 _ANY_SIGN = ("declination_deg",)
-_NON_NEGATIVE = ("lever_arm", "tilt_rate_noise", "heading_rate_noise", "mag_reject_s",
+_NON_NEGATIVE = ("lever_arm", "tilt_rate_noise", "heading_rate_noise", "mag_reject_s", "rest_min_s",
                  "mag_delay_s", "latency_s", "mag_delay_max_s", "mag_disturbed_power")
 
 
