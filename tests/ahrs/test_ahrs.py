@@ -385,10 +385,12 @@ def test_cli_ahrs_csv_roundtrip_and_degraded_mode(tmp_path, capsys):
     assert meta["frame"] == "ENU" and meta["heading_observed"] is True
     assert meta["mode"].startswith("causal")
     assert main(["ahrs", "--imu", str(tmp_path / "imu.csv"), "--gyro-units", "deg/s",
-                 "--acc-units", "g", "--offline", "--out", str(tmp_path / "off.csv")]) == 0
+                 "--acc-units", "g", "--offline", "--gyro-sample", "point", "--out",
+                 str(tmp_path / "off.csv")]) == 0
     off = np.genfromtxt(tmp_path / "off.csv", delimiter=",", names=True)
     assert off.size == t.size
-    assert json.loads((tmp_path / "off.csv.meta.json").read_text())["mode"].startswith("offline")
+    off_meta = json.loads((tmp_path / "off.csv.meta.json").read_text())
+    assert off_meta["mode"].startswith("offline") and off_meta["config"]["gyro_sample"] == "point"
     # no magnetometer columns: heading not observed, said so
     np.savetxt(tmp_path / "nomag.csv", np.column_stack([t, w, acc]), delimiter=",",
                header="t,gx[rad/s],gy[rad/s],gz[rad/s],ax[m/s2],ay[m/s2],az[m/s2]",

@@ -52,6 +52,10 @@ def _arguments(p: argparse.ArgumentParser) -> None:
                    help="post-processing: run the filter forward and backward and combine the "
                    "two (acausal: every estimate uses the whole recording; not a real-time "
                    "filter)")
+    p.add_argument("--gyro-sample", choices=["interval", "point"], default="interval",
+                   help="what a gyro sample is: the mean rate over the period ending at its "
+                   "stamp (interval: MEMS IMUs, VQF's convention; each output predicted half a "
+                   "period ahead) or the rate at the stamp (point: exact simulations)")
     p.add_argument("--no-mag", action="store_true", help="ignore the magnetometer")
     p.add_argument("--no-gating", action="store_true",
                    help="accept every measurement (no innovation gating or disturbance checks)")
@@ -65,7 +69,8 @@ def run(args: argparse.Namespace) -> int:
     from strapdown.ahrs import AhrsConfig
     from strapdown.apps.ahrs_log import run_ahrs
 
-    cfg = AhrsConfig(gating=not args.no_gating, declination_deg=args.declination_deg)
+    cfg = AhrsConfig(gating=not args.no_gating, declination_deg=args.declination_deg,
+                     gyro_sample=args.gyro_sample)
     res, meta = run_ahrs(args.imu, args.out, algorithm=args.algorithm, frame=args.frame,
                          config=cfg, gyro_units=args.gyro_units, acc_units=args.acc_units,
                          columns=None if args.columns is None else columns(args.columns),
