@@ -171,14 +171,6 @@ def _imu_log(path, t):
     return str(path)
 
 
-_AHRS_JITTER_REGRESSION = pytest.mark.xfail(
-    reason="since the issue-18 filter (commit 3092abd) the jittered record's error exceeds 2x "
-    "the clean one's, with --resample too (e.g. rate-single 1.6e-3, rate-three 3.3e-3, "
-    "sliding 1.8e-3 against 7.7e-4 to 8.6e-4 rad clean); the magnetometer-delay estimator is "
-    "not the cause. Open.", strict=False)
-
-
-@_AHRS_JITTER_REGRESSION
 @pytest.mark.parametrize("algorithm", AHRS_SPECS)
 def test_ahrs_jittered_log(tmp_path, capsys, algorithm):
     t, tj = _stamps(5, 10_001)
