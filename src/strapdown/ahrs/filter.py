@@ -242,7 +242,7 @@ class AhrsConfig:
     """
 
     gyro_noise: float = 9.8e-4
-    gyro_bias_rw: float = 2.5e-6
+    gyro_bias_rw: float = 5e-6
     gyro_bias_sigma0: float = 0.01
     tilt_rate_noise: float = 4.2e-3
     heading_rate_noise: float = 5e-4
@@ -279,7 +279,7 @@ class AhrsConfig:
     recover_acc_s: float = 2.0
     recover_mag_s: float = 10.0
     recover_angle: float = 0.1
-    rest_gyro: float = 0.04
+    rest_gyro: float = 0.0035
     rest_gyro_mean: float = 0.035
     rest_min_s: float = 0.5
     rest_acc: float = 0.2
