@@ -6,7 +6,7 @@ STAMP  := $(VENV)/.installed
 DEVSTAMP := $(VENV)/.installed-dev
 DEMO_OUT ?= reports/li2017
 
-.PHONY: demo test bench lint clean
+.PHONY: demo test bench lint fuzz clean
 
 $(PY):
 	$(PYTHON) -m venv $(VENV)
@@ -28,6 +28,14 @@ demo: $(STAMP)
 ## test: install dev extras, lint (style, import layers, types), run the whole suite
 test: lint
 	$(PY) -m pytest -q
+
+## fuzz: the long fuzz campaign — the corpus and >= 10^4 generated hostile files through every
+## reader and every command that reads a file, under a memory cap and a time limit (counts per
+## format at the end; fails on any exception but InputError, traceback, signal, run over 10 s,
+## peak over 500 MB or partial output), then the hypothesis strategies at 2000 examples each
+fuzz: $(DEVSTAMP)
+	$(PY) tests/fuzz/campaign.py --profile long
+	STRAPDOWN_FUZZ_EXAMPLES=2000 $(PY) -m pytest -q -p no:cacheprovider tests/fuzz/test_fuzz_files.py -k "not campaign"
 
 ## bench: throughput benchmarks with peers (numbers are reported, never asserted)
 bench: $(STAMP)

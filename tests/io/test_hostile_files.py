@@ -219,3 +219,20 @@ def test_realtime_with_fewer_samples_than_n_is_an_error_not_an_empty_file(tmp_pa
         run_log(path, tmp_path / "a.csv", kind="increment", units="rad", subsamples=3,
                 structure="realtime")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["inc.csv"]
+
+
+def test_an_overflowing_increment_log_is_one_line_from_compare(files, tmp_path, capsys):
+    """1e308-rad increments made ``g / h`` overflow in the unit check: a RuntimeWarning and its
+    source line printed before the error (found by the fuzz campaign)."""
+    import warnings
+
+    from strapdown.cli import main
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        with pytest.raises(SystemExit) as exc:
+            main(["compare", "--imu", str(files["npy_1e308"].path), "--increments", "--units",
+                  "rad", "--algorithms", "rotvec:N=2", "--out", str(tmp_path / "cmp")])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1 and "turns the body by 1e+308 rad" in err

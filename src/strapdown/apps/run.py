@@ -123,8 +123,9 @@ def _npy_chunks(path: Path, arr: NDArray[Any], units: GyroUnit, read: dict[str, 
             h = float(d[0])
         if h is not None:
             if last is None:
-                warn_implausible_rate(path, c[:, 1:] * (scale / h), units,
-                                      action=read["unit_check"])
+                with np.errstate(over="ignore"):  # refused by check_motion below
+                    rate = c[:, 1:] * (scale / h)
+                warn_implausible_rate(path, rate, units, action=read["unit_check"])
             check_motion(path, c[:, 1:] * scale, "increment", h, s + 1)
             for i in np.flatnonzero(d > read["gap_tolerance"] * h):
                 row = s + int(i) + first + 1

@@ -734,7 +734,9 @@ def read_imu(path: str | os.PathLike[str], *, kind: InputKind, units: GyroUnit |
         saturated = [int(i) + 1 for i in np.flatnonzero(np.any(np.abs(g) >= saturation, axis=1))]
     scale = _DEG if unit.startswith("deg") else 1.0
     g = g * scale
-    warn_implausible_rate(path, g if kind == "rate" else g / h, unit, action=unit_check)
+    with np.errstate(over="ignore"):  # an overflowing rate is refused by check_motion
+        rate = g if kind == "rate" else g / h
+    warn_implausible_rate(path, rate, unit, action=unit_check)
     check_motion(path, g, kind, unit_h)
     return ImuLog(np.asarray(t, float), np.ascontiguousarray(g), kind, h, gaps, saturated,
                   unit, nominal)
