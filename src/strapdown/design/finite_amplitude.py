@@ -52,7 +52,8 @@ from gmpy2 import mpq
 
 from strapdown.design.designer import Design, Structure, derive
 
-__all__ = ["A_ORDER", "derive_spin_robust", "derive_triple", "drift_series", "leading_terms",
+__all__ = ["A_ORDER", "derive_spin_robust", "derive_triple", "derive_triple_a6", "drift_series",
+           "leading_terms", "with_a6_triples",
            "with_last_triples", "with_triples_to_last"]
 
 #: Highest power of ``a`` carried by :func:`drift_series`.
@@ -439,3 +440,126 @@ def derive_spin_robust(structure: Structure, *, amplitude: bool = True) -> Desig
     series = drift_series(structure, plain.coefficients, tri)
     return replace(plain, structure=structure, triple_coefficients=tri,
                    amplitude_law=leading_terms(series), conditions=plain.conditions + a.rows)
+
+
+def with_a6_triples(structure: Structure) -> Structure:
+    """``structure`` with the triple terms of :func:`with_last_triples` plus
+    ``θ_{L−1} × (θ_{L−m} × θ_L)``, m = 2 … L: the candidates of :func:`derive_triple_a6`
+    (N − 3 more free coefficients than the ``a⁴`` conditions through ``x^{2N+2}`` use)."""
+    last = len(structure.nodes) - 1
+    extra = tuple((last - 1, last - m, last) for m in range(2, last + 1))
+    st = with_last_triples(structure)
+    return replace(st, name=f"{structure.name}, triple θ_L×(θ_(L−m)×θ_L), "
+                   "θ_(L−1)×(θ_(L−m)×θ_L)", triples=st.triples + extra)
+
+
+def _a4_affine_space(structure: Structure, pairs, top: int):
+    """Triple coefficients meeting every ``a⁴ x^q`` condition, q ≤ ``top``, exactly: a
+    particular solution and a basis of the free directions (sympy, exact)."""
+    k = len(structure.triples)
+    zeros = (Fraction(0),) * k
+    base = drift_series(structure, pairs, zeros, x_order=top, a_order=4)[4]
+    cols = []
+    for j in range(k):
+        unit = tuple(Fraction(int(i == j)) for i in range(k))
+        cols.append(drift_series(structure, pairs, unit, x_order=top, a_order=4)[4])
+    a = sp.Matrix([[_to_sp(c[q] - base[q]) for c in cols] for q in range(top + 1)])
+    rhs = sp.Matrix([-_to_sp(base[q]) for q in range(top + 1)])
+    if a.rank() != a.row_join(rhs).rank():
+        raise ValueError(f"{structure.name!r}: its triple terms cannot cancel the a⁴ drift "
+                         f"through (Ωh)^{top}")
+    sol, params = a.gauss_jordan_solve(rhs)
+    tau0 = sol.subs({p: 0 for p in params})
+    return tau0, [sol.diff(p) for p in params]
+
+
+def _a6_quadratics(structure: Structure, pairs, tau0, basis, qs):
+    """The ``a⁶ x^q`` drift coefficients (q in ``qs``) on the affine space ``tau0 + Σ p_i
+    basis_i`` as exact quadratic polynomials in the ``p_i`` (``a⁶`` is quadratic in the
+    triple coefficients: triple terms are ``O(a³)``), by interpolation at the points
+    ``0, e_i, 2e_i, e_i + e_j``."""
+    d, k = len(basis), len(structure.triples)
+    ps = sp.symbols(f"p0:{d}")
+    pts = [(0,) * d]
+    for i in range(d):
+        pts += [tuple(s * int(j == i) for j in range(d)) for s in (1, 2)]
+    pts += [tuple(int(j in (i1, i2)) for j in range(d)) for i1 in range(d)
+            for i2 in range(i1 + 1, d)]
+    mons = [sp.Integer(1), *ps, *(ps[i] * ps[j] for i in range(d) for j in range(i, d))]
+    vals = []
+    for pt in pts:
+        tau = tau0 + sum((basis[i] * pt[i] for i in range(d)), sp.zeros(k, 1))
+        vals.append(drift_series(structure, pairs, tuple(Fraction(int(sp.fraction(v)[0]),
+                                                                  int(sp.fraction(v)[1]))
+                                                         for v in tau),
+                                 x_order=max(qs), a_order=6)[6])
+    m_inv = sp.Matrix([[m.subs(dict(zip(ps, pt, strict=True))) for m in mons]
+                       for pt in pts]).inv()
+    out = []
+    for q in qs:
+        c = m_inv * sp.Matrix([_to_sp(v[q]) for v in vals])
+        out.append(sum((ci * m for ci, m in zip(c, mons, strict=True)), sp.Integer(0)))
+    return ps, out
+
+
+@functools.lru_cache(maxsize=16)
+def derive_triple_a6(structure: Structure, *, digits: int = 50, starts: int = 40,
+                     seed: int = 0) -> Design:
+    """Like :func:`derive_triple`, and the leading ``a⁶`` drift cancelled too.
+
+    ``structure`` lists its triple terms (e.g. :func:`with_a6_triples`). The ``a⁴`` drift is
+    affine in the triple coefficients: its conditions through ``x^{2N+2}`` are solved
+    exactly, leaving ``d`` free directions; the ``a⁶`` drift is quadratic in them, and its
+    ``x^6, x^8, …`` coefficients (``d`` of them) are set to zero by Newton's method
+    (``mpmath.findroot`` at ``digits`` digits, ``starts`` seeded starting points; the root
+    with the smallest largest coefficient is kept). The root is algebraic, not rational: the
+    free parameters are rounded to rationals with denominators below 10^24, so the ``a²``
+    and ``a⁴`` conditions hold exactly and the cancelled ``a⁶`` coefficients are below
+    1e-20 (checked).
+    """
+    import mpmath
+    import numpy as np
+
+    if not structure.triples:
+        raise ValueError(f"{structure.name!r} has no triple terms; add them with "
+                         "with_a6_triples()")
+    plain = derive(replace(structure, triples=()))
+    top = (plain.order if plain.order is not None else 2 * structure.n) + 2
+    tau0, basis = _a4_affine_space(structure, plain.coefficients, top)
+    if not basis:
+        raise ValueError(f"{structure.name!r}: no freedom left for the a⁶ terms after the a⁴ "
+                         "conditions; give more triple terms (with_a6_triples)")
+    qs = tuple(range(6, 6 + 2 * len(basis), 2))
+    ps, polys = _a6_quadratics(structure, plain.coefficients, tau0, basis, qs)
+    rng = np.random.default_rng(seed)
+    best = None
+    with mpmath.workdps(digits):
+        fs = [sp.lambdify(ps, f, "mpmath") for f in polys]
+        for _ in range(starts):
+            x0 = [mpmath.mpf(float(v)) for v in rng.normal(scale=3.0, size=len(ps))]
+            try:
+                r = mpmath.findroot(lambda *p: [f(*p) for f in fs], x0)
+            except (ValueError, ZeroDivisionError):
+                continue
+            r = [r[i] for i in range(len(ps))] if hasattr(r, "rows") else [r]
+            tau = [tau0[i] + sum(basis[j][i] * r[j] for j in range(len(ps)))
+                   for i in range(len(tau0))]
+            size = max(abs(mpmath.mpf(sp.N(v, digits))) for v in tau)
+            if best is None or size < best[0]:
+                best = (size, [Fraction(mpmath.nstr(v, digits)).limit_denominator(10**24)
+                               for v in r])
+    if best is None:
+        raise ArithmeticError(f"{structure.name!r}: no real root of the a⁶ conditions found")
+    p = best[1]
+    tau = tau0 + sum((basis[j] * _to_sp(p[j]) for j in range(len(p))),
+                     sp.zeros(len(tau0), 1))
+    tri = tuple(Fraction(int(sp.fraction(v)[0]), int(sp.fraction(v)[1])) for v in tau)
+    series = drift_series(structure, plain.coefficients, tri)
+    if series[2] != drift_series(structure, plain.coefficients, (Fraction(0),) * len(tri))[2]:
+        raise ArithmeticError("the triple terms changed the a² drift; the design is wrong")
+    if any(series[4][:top + 1]) or any(abs(series[6][q]) > 1e-20 for q in qs):
+        raise ArithmeticError("the a⁴/a⁶ conditions are not met; the design is wrong")
+    law = leading_terms({pw: tuple(v if pw != 6 or q not in qs else Fraction(0)
+                                   for q, v in enumerate(row)) for pw, row in series.items()})
+    return replace(plain, structure=structure, triple_coefficients=tri, amplitude_law=law,
+                   conditions=plain.conditions + top // 2 - 1 + len(qs))
