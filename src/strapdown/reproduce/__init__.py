@@ -19,7 +19,7 @@ __all__ = ["REPRODUCTIONS", "Reproduction", "ReproductionName", "reproduction"]
 
 #: The reproductions' command-line names, in the order the command line lists them.
 ReproductionName = Literal["li2017", "wang-rate", "wang-sliding", "plaksiy2024", "zhang2021",
-                           "sculling"]
+                           "sculling", "high-order"]
 
 
 @dataclass(frozen=True)
@@ -44,6 +44,9 @@ REPRODUCTIONS: dict[ReproductionName, Reproduction] = {
     "sculling": Reproduction("strapdown.reproduce.sculling",
                              "sculling law and duality (Savage, Ignagni), WGS-84 navigation, "
                              "smsfusion"),
+    "high-order": Reproduction("strapdown.reproduce.high_order",
+                               "finite-amplitude coning sets (triple cross products), spin plus "
+                               "coning, and advise on a vibration log"),
 }
 
 
