@@ -124,3 +124,38 @@ def test_rate_paper_coefficients_match(tmp_path):
     t, w = _rates()
     py = rate.rate_attitude(t, w, algorithm="rate-three", coefficients="paper", q0=q0).q
     assert np.max(np.abs(drive(e, lib, w, q0) - py)) <= 1e-13
+
+
+@pytest.mark.parametrize(("structure", "n"), [("conventional", 2), ("conventional", 4),
+                                              ("conventional", 6), ("single-chain", 2),
+                                              ("single-chain", 3), ("single-chain", 6)])
+def test_finite_amplitude_sets_match(tmp_path, structure, n):
+    # triple cross products θ_m × (θ_i × θ_j) in C, the kernels' operations in their order
+    from strapdown.codegen.export_c import generate
+
+    q0 = MOTION.attitude(0.0)
+    th = _increments()
+    e, lib = build(tmp_path, algorithm="rotvec", structure=structure, subsamples=n, h=H,
+                   coefficients="finite-amplitude")
+    c = drive(e, lib, th, q0)
+    if structure == "single-chain":
+        py = single_chain(th, n, h=H, q0=q0, triple=True).q
+        plain = single_chain(th, n, h=H, q0=q0).q
+    else:
+        m = th.shape[0] - th.shape[0] % n
+        py = conventional(th[:m], coefficient_set("finite-amplitude", n), h=H, q0=q0).q
+        plain = conventional(th[:m], coefficient_set("table3", n), h=H, q0=q0).q
+    assert c.shape == py.shape
+    assert np.max(np.abs(c - py)) <= 1e-13
+    assert np.max(np.abs(py - plain)) > 1e-12  # the triple terms are there
+    assert "malloc" not in e.source and "sd_triple_add" in e.source
+    base = generate("rotvec", structure=structure, subsamples=n, h=H).ops
+    assert e.ops["mul"] - base["mul"] == 15 * (n - 1)
+    assert e.ops["add"] - base["add"] == 9 * (n - 1)
+
+
+def test_finite_amplitude_refused_in_realtime():
+    from strapdown.codegen.export_c import generate
+
+    with pytest.raises(ValueError, match="not realtime"):
+        generate("rotvec", structure="realtime", subsamples=3, coefficients="finite-amplitude")
