@@ -260,3 +260,21 @@ def test_a6_design_needs_free_coefficients():
         FA.derive_triple_a6(FA.with_a6_triples(D.interval_structure(3)))
     with pytest.raises(ValueError, match="no triple terms"):
         FA.derive_triple_a6(D.interval_structure(5))
+
+
+def test_linear_n6_set_at_the_band_edge():
+    # conventional N = 6, a = 1°, Ω = 2π, Ωh = 0.2 (the acceptance band's edge): the linear
+    # set (a⁴ only) drifts 2.79× its a² law, 9.1e-16 rad/s (just under the ~1e-15 float64
+    # floor); its a⁶ x⁶ … x¹⁰ terms (4.5e-15, −6.0e-15, 7.6e-16) are what the a⁶ set removes
+    import math
+
+    from strapdown.algorithms.spec import AlgorithmSpec
+    from strapdown.analysis.frequency_response import classical_coning_drift
+
+    a, om, x = math.radians(1.0), 2 * math.pi, 0.2
+    law = -a**2 * om * x**12 / 24024
+    lin = classical_coning_drift(AlgorithmSpec.parse("rotvec:N=6:coefficients=finite-amplitude"),
+                                 a, x, cone_rate=om)
+    assert lin / law == pytest.approx(2.79, abs=0.01) and abs(lin) < 1e-15
+    _, w = _window(FA.derive_triple_a6(FA.with_a6_triples(D.interval_structure(6))))
+    assert classical_coning_drift(w, a, x, cone_rate=om) / law == pytest.approx(1.23, abs=0.01)
