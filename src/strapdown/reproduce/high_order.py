@@ -435,7 +435,8 @@ VIBRATION = {"fs": 400.0, "samples": 8000, "band_hz": (5.0, 40.0), "tones": 8,
 BUDGET_DEG_H = 0.05
 #: Candidates whose drift is measured on the log beside the recommendation.
 MEASURED = ("rotvec:N=1", "rotvec:N=2", "rotvec:N=3", "rotvec:N=3:structure=single-chain",
-            "rotvec:N=4:coefficients=finite-amplitude")
+            "rotvec:N=4", "rotvec:N=4:coefficients=finite-amplitude",
+            "rotvec:N=4:structure=single-chain", "rotvec:N=6:structure=single-chain")
 _DEG_H = 180.0 / math.pi * 3600.0
 
 
@@ -560,7 +561,7 @@ def _scaling_table(r: Report, best: str) -> str:
                          _g(measured_drift_deg_h(spec, vib, inc, h), 4)])
     return ("\nThe same vibration with every amplitude scaled (half the samples): the "
             "prediction is second order in the rates (×1/4 per halving); a measured drift "
-            "falling faster or slower than that holds terms the spectral prediction does not "
-            "have (products of three or more tones):\n\n"
+            "falling faster or slower than that holds terms of another order in the amplitude, "
+            "which the spectral prediction does not have:\n\n"
             + r.table("advise_scaling", ["amplitude scale", "spec", "predicted (deg/h)",
                                          "measured (deg/h)"], rows))
