@@ -32,6 +32,13 @@ Result (N = 3 … 6, both structures; :func:`derive_triple`): with the triple te
 this linear design cannot remove it) and dominates the conventional N = 5, 6 sets at small
 ``x``, where the drift is far below the float64 floor.
 
+:func:`derive_triple_a6` removes it too: with the extra terms ``θ_{N−1} × (θ_{N−m} × θ_N)``
+(:func:`with_a6_triples`) the ``a⁴`` conditions through ``x^{2N+2}`` leave N − 3 free
+directions, and the ``a⁶ x⁶, x⁸, …`` coefficients, quadratic in them, are zeroed by Newton's
+method (an algebraic root, rounded to rationals). Conventional N = 6 at ``a = 1°``: 1.23–1.26×
+the ``a²`` law over Ωh 0.05–0.2 (the linear set: 2.79× at 0.2, and the ``a⁶`` term below);
+N = 5: 0.98–1.00× over 0.005–0.2. For the single chain no real root is found with these terms.
+
 Spin plus coning (``spin_ratio`` σ = ω_s/Ω, :func:`derive_spin_robust`): with body spin the
 axial increment is ``O(1)``, the ``a²`` drift of Table 3 drops to ``(Ωh)⁴`` (e.g.
 ``−12/5 a²Ω(Ωh)⁴`` for N = 3 at σ = 3), and triple terms enter it. Its ``(Ωh)⁴``
