@@ -58,7 +58,7 @@ def test_spin_robust_set_beats_table3_and_table7_at_ratio_10():
 def test_vibration_log_drift_is_the_line_prediction_for_n3(tmp_path):
     vib, inc, h = H.vibration_log(tmp_path / "log.csv")
     with open(tmp_path / "log.csv", newline="") as fh:
-        assert sum(1 for _ in csv.reader(fh)) == H.VIBRATION["samples"] + 1
+        assert sum(1 for _ in csv.reader(fh)) == H.VIBRATION.samples + 1
     spec = AlgorithmSpec.parse("rotvec:N=3")
     pred = np.linalg.norm(predict_drift_lines(spec, vib.omega, vib.coning_power(), h))
     assert H.measured_drift_deg_h(spec, vib, inc, h) == pytest.approx(

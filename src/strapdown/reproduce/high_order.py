@@ -427,10 +427,21 @@ def _spin_figure(r: Report, d: dict, labels: list[str]) -> None:
     r.add("\n![spin plus coning](spin_coning.png)\n")
 
 
-#: The simulated vibration log: sample rate (Hz), samples, tone band (Hz), tones, per-axis
-#: rotation-vector amplitude per tone (rad) and phase offsets (rad): x lags, y and z cone.
-VIBRATION = {"fs": 400.0, "samples": 8000, "band_hz": (5.0, 40.0), "tones": 8,
-             "amplitude": (1e-3, 4e-3, 4e-3), "relative_phase": (0.0, 1.2, 0.0)}
+@dataclass(frozen=True)
+class VibrationCase:
+    """The simulated log: sample rate (Hz), samples, tone band (Hz), tones, per-axis
+    rotation-vector amplitude per tone (rad) and phase offsets (rad)."""
+
+    fs: float = 400.0
+    samples: int = 8000
+    band_hz: tuple[float, float] = (5.0, 40.0)
+    tones: int = 8
+    amplitude: tuple[float, float, float] = (1e-3, 4e-3, 4e-3)
+    relative_phase: tuple[float, float, float] = (0.0, 1.2, 0.0)
+
+
+#: The simulated vibration log of the report (x lags, y and z cone about x).
+VIBRATION = VibrationCase()
 #: Drift budget handed to ``strapdown advise`` (deg/h).
 BUDGET_DEG_H = 0.05
 #: Candidates whose drift is measured on the log beside the recommendation.
@@ -444,11 +455,11 @@ def vibration_log(path: Path):
     """Write the seeded random-vibration log (increments, CSV) to ``path``; returns the
     vibration (exact truth), the increments and h."""
     v = VIBRATION
-    vib = random_tone_vibration(v["band_hz"], v["tones"], v["amplitude"], v["relative_phase"],
+    vib = random_tone_vibration(v.band_hz, v.tones, v.amplitude, v.relative_phase,
                                 np.random.default_rng(VIBRATION_SEED))
-    h = 1.0 / v["fs"]
-    inc = sensors.increments(vib.motion(), h, v["samples"]).data
-    t = np.arange(1, v["samples"] + 1) * h
+    h = 1.0 / v.fs
+    inc = sensors.increments(vib.motion(), h, v.samples).data
+    t = np.arange(1, v.samples + 1) * h
     write_text(path, "t,gx[rad],gy[rad],gz[rad]\n" + "".join(
         f"{a:.9f},{x:.17g},{y:.17g},{z:.17g}\n" for a, (x, y, z) in zip(t, inc, strict=True)))
     return vib, inc, h
@@ -467,8 +478,8 @@ def run_advise(log: Path, figure: Path) -> dict:
 
 def vibration_period() -> float:
     """The log's common period (s): its tones are whole multiples of their spacing."""
-    lo, hi = VIBRATION["band_hz"]
-    step = (hi - lo) / (VIBRATION["tones"] - 1)
+    lo, hi = VIBRATION.band_hz
+    step = (hi - lo) / (VIBRATION.tones - 1)
     if abs(lo / step - round(lo / step)) > 1e-12:
         raise ValueError("the tones are not multiples of one frequency: no common period")
     return 1.0 / step
@@ -504,16 +515,16 @@ def _advise_section(r: Report) -> list[str]:
         lines = np.linalg.norm(predict_drift_lines(spec, vib.omega, vib.coning_power(), h))
         meas = measured_drift_deg_h(spec, vib, inc, h)
         rows.append([text + (" (recommended)" if text == best else ""),
-                     _g(cands[text]["predicted_drift_deg_h"], 4), _g(lines * _DEG_H, 4),
+                     _g(cands[text]["predicted_drift_deg_h"], 4), _g(float(lines) * _DEG_H, 4),
                      _g(meas, 4), _g(cands[text]["ops_per_s"], 4)])
     top = [[c["spec"], _g(c["predicted_drift_deg_h"], 4), _g(c["ops_per_s"], 4),
             "yes" if c["spec"] in rec["pareto"] else ""] for c in rec["candidates"][:12]]
     v = VIBRATION
     r.add("\n## `strapdown advise` on a simulated random-vibration log\n\n"
-          f"{v['tones']} tones over {v['band_hz'][0]:g}–{v['band_hz'][1]:g} Hz, rotation-vector "
-          f"amplitudes {v['amplitude']} rad per tone on x, y, z with phase offsets "
-          f"{v['relative_phase']} rad (y and z cone about x), seed {VIBRATION_SEED}, "
-          f"{v['samples']} increments at {v['fs']:g} Hz (exact attitude; "
+          f"{v.tones} tones over {v.band_hz[0]:g}–{v.band_hz[1]:g} Hz, rotation-vector "
+          f"amplitudes {v.amplitude} rad per tone on x, y, z with phase offsets "
+          f"{v.relative_phase} rad (y and z cone about x), seed {VIBRATION_SEED}, "
+          f"{v.samples} increments at {v.fs:g} Hz (exact attitude; "
           "[vibration_log.csv](vibration_log.csv)). Command:\n\n"
           f"    strapdown advise --imu vibration_log.csv --increments --budget-deg-h "
           f"{BUDGET_DEG_H:g} --figure advise.png --json\n\n"
@@ -547,17 +558,17 @@ def _scaling_table(r: Report, best: str) -> str:
     prediction scales as the square; whatever else the measurement holds shows its own
     power."""
     v = VIBRATION
-    h = 1.0 / v["fs"]
+    h = 1.0 / v.fs
     specs = tuple(dict.fromkeys((best, "rotvec:N=3", "rotvec:N=6:structure=single-chain")))
     rows = []
     for scale in SCALES:
-        vib = random_tone_vibration(v["band_hz"], v["tones"], np.array(v["amplitude"]) * scale,
-                                    v["relative_phase"], np.random.default_rng(VIBRATION_SEED))
-        inc = sensors.increments(vib.motion(), h, v["samples"] // 2).data
+        vib = random_tone_vibration(v.band_hz, v.tones, np.array(v.amplitude) * scale,
+                                    v.relative_phase, np.random.default_rng(VIBRATION_SEED))
+        inc = sensors.increments(vib.motion(), h, v.samples // 2).data
         for text in specs:
             spec = AlgorithmSpec.parse(text)
             pred = np.linalg.norm(predict_drift_lines(spec, vib.omega, vib.coning_power(), h))
-            rows.append([f"{scale:g}", text, _g(pred * _DEG_H, 4),
+            rows.append([f"{scale:g}", text, _g(float(pred) * _DEG_H, 4),
                          _g(measured_drift_deg_h(spec, vib, inc, h), 4)])
     return ("\nThe same vibration with every amplitude scaled (half the samples): the "
             "prediction is second order in the rates (×1/4 per halving); a measured drift "
