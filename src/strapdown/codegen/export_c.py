@@ -191,7 +191,9 @@ def _generate_nav(structure: StructureName, subsamples: int,
     name = name or f"sd_nav_{structure.replace('-', '_')}_n{subsamples}"
     if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", name):
         raise ValueError(f"name must be a C identifier, got {name!r}")
-    header, source, ops = generate_nav(structure, subsamples, name, _common("double"))
+    common = _common("double")
+    common = common[:common.index("\n/* phi += c m x (a x b)")]  # nav has no triple terms
+    header, source, ops = generate_nav(structure, subsamples, name, common)
     return CExport(name, header, source, ops, real)
 
 
@@ -249,7 +251,7 @@ int {name}_update({name}_state *s, const real_t sample[3], real_t q_out[4]);
 """
     common = _common(real)
     cross = common.index("static void sd_cross_add")
-    triple = common.index("/* phi += c m x (a x b)")
+    triple = common.index("\n/* phi += c m x (a x b)")
     helpers = ("" if algorithm == "rk4" else common[:cross]) + (
         common[cross:triple] if "sd_cross_add" in body or "sd_triple_add" in body else "") + (
         common[triple:] if "sd_triple_add" in body else "")
