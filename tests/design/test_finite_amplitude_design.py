@@ -278,3 +278,23 @@ def test_linear_n6_set_at_the_band_edge():
     assert lin / law == pytest.approx(2.79, abs=0.01) and abs(lin) < 1e-15
     _, w = _window(FA.derive_triple_a6(FA.with_a6_triples(D.interval_structure(6))))
     assert classical_coning_drift(w, a, x, cone_rate=om) / law == pytest.approx(1.23, abs=0.01)
+
+
+@pytest.mark.parametrize("n", [5, 6])
+def test_a6_design_through_the_law_order(n):
+    # one more term, θ_(L−2)×(θ_(L−3)×θ_L): a⁶ cancelled through x^{2N}, so the set follows
+    # its a² law to 5 % at a = 1° over Ωh 0.05–0.2 (N = 6: 0.958–0.996; without: 1.23–1.26)
+    import math
+
+    from strapdown.analysis.frequency_response import classical_coning_drift
+
+    d = FA.derive_triple_a6(FA.with_a6_triples(D.interval_structure(n), through_law=True))
+    assert [(p, q) for p, q, _ in d.amplitude_law] == [(2, 2 * n), (4, 2 * n + 4),
+                                                       (6, 2 * n + 2)]
+    _, w = _window(d)
+    a, om = math.radians(1.0), 2 * math.pi
+    for x in (0.05, 0.1, 0.2):
+        law = -float(d.drift_constant) * a**2 * om * x ** (2 * n)
+        assert classical_coning_drift(w, a, x, cone_rate=om) / law == pytest.approx(1, abs=0.05)
+    with pytest.raises(ValueError, match="N ≥ 4"):
+        FA.with_a6_triples(D.interval_structure(3), through_law=True)

@@ -449,15 +449,23 @@ def derive_spin_robust(structure: Structure, *, amplitude: bool = True) -> Desig
                    amplitude_law=leading_terms(series), conditions=plain.conditions + a.rows)
 
 
-def with_a6_triples(structure: Structure) -> Structure:
+def with_a6_triples(structure: Structure, *, through_law: bool = False) -> Structure:
     """``structure`` with the triple terms of :func:`with_last_triples` plus
     ``θ_{L−1} × (θ_{L−m} × θ_L)``, m = 2 … L: the candidates of :func:`derive_triple_a6`
-    (N − 3 more free coefficients than the ``a⁴`` conditions through ``x^{2N+2}`` use)."""
+    (N − 3 more free coefficients than the ``a⁴`` conditions through ``x^{2N+2}`` use, so the
+    ``a⁶`` terms ``x⁶ … x^{2N−2}`` can be cancelled). ``through_law`` adds
+    ``θ_{L−2} × (θ_{L−3} × θ_L)`` (N ≥ 4): one more, so ``a⁶`` goes through ``x^{2N}``,
+    the order of the ``a²`` law (at the price of larger coefficients for N = 6)."""
     last = len(structure.nodes) - 1
     extra = tuple((last - 1, last - m, last) for m in range(2, last + 1))
+    name = f"{structure.name}, triple θ_L×(θ_(L−m)×θ_L), θ_(L−1)×(θ_(L−m)×θ_L)"
+    if through_law:
+        if last < 3:
+            raise ValueError("through_law needs N ≥ 4 nodes (the term θ_(L−2)×(θ_(L−3)×θ_L))")
+        extra += ((last - 2, last - 3, last),)
+        name += ", θ_(L−2)×(θ_(L−3)×θ_L)"
     st = with_last_triples(structure)
-    return replace(st, name=f"{structure.name}, triple θ_L×(θ_(L−m)×θ_L), "
-                   "θ_(L−1)×(θ_(L−m)×θ_L)", triples=st.triples + extra)
+    return replace(st, name=name, triples=st.triples + extra)
 
 
 def _a4_affine_space(structure: Structure, pairs, top: int):
