@@ -314,7 +314,7 @@ def _spot_check_section(r: Report) -> None:
     r.add("\n## Spot checks: arbitrary-precision simulation\n\n"
           "Each set run on the closed-form increments in arbitrary precision (40 digits) over "
           "two cone periods, drift from the chains' slopes at whole periods "
-          "(:func:`chain_drift_rate`), against the exact response:\n\n")
+          "(`chain_drift_rate`), against the exact response:\n\n")
     r.add(r.table("spot_checks", ["set", "N", "a (deg)", "Ωh", "simulated (rad/s)",
                                   "exact response (rad/s)", "relative difference"], rows))
 
@@ -386,7 +386,7 @@ def _spin_section(r: Report) -> list[str]:
                            f"(at ratio 10: {_g(gain[-1])}).")
     r.add("\n## Spin plus coning\n\n"
           "Exact drift about the cone axis (rad/s) of N = 3 sets under coning with body spin "
-          "(:class:`SpinConing`, Ω = 2π rad/s, spin ω_s = ratio × Ω). Spin-robust: Table 3's "
+          "(`SpinConing`, Ω = 2π rad/s, spin ω_s = ratio × Ω). Spin-robust: Table 3's "
           "pairs plus six triple terms θ_m × (θ_i × θ_3) from `derive_spin_robust` (the "
           "a²(Ωh)⁴ drift cancelled for every ratio, the classical a⁴ drift through (Ωh)⁶); "
           "Table 7: Zhang & Yu (2021) in the structure we infer; plain sets: Table 3 (the "
