@@ -159,3 +159,33 @@ def test_finite_amplitude_refused_in_realtime():
 
     with pytest.raises(ValueError, match="not realtime"):
         generate("rotvec", structure="realtime", subsamples=3, coefficients="finite-amplitude")
+
+
+def test_designed_a6_set_exports_and_matches(tmp_path):
+    # any CoefficientSet (here the a⁶ finite-amplitude design, 9 triple terms at N = 6)
+    import ctypes
+    import subprocess
+
+    from c_harness import FLAGS, compiler
+    from strapdown.codegen.export_c import generate_coefficient_set
+    from strapdown.design import designer as D
+    from strapdown.design import finite_amplitude as FA
+
+    cs = FA.derive_triple_a6(FA.with_a6_triples(D.interval_structure(6))).coefficient_set(
+        "finite-amplitude-a6")
+    e = generate_coefficient_set(cs)
+    (tmp_path / f"{e.name}.h").write_text(e.header)
+    (tmp_path / f"{e.name}.c").write_text(e.source)
+    lib = tmp_path / f"lib{e.name}.so"
+    res = subprocess.run([compiler(), *FLAGS, "-o", str(lib), str(tmp_path / f"{e.name}.c"),
+                          "-lm"], capture_output=True, text=True)
+    assert res.returncode == 0, res.stderr
+    q0 = MOTION.attitude(0.0)
+    th = _increments()
+    m = th.shape[0] - th.shape[0] % 6
+    c = drive(e, ctypes.CDLL(str(lib)), th[:m], q0)
+    py = conventional(th[:m], cs, h=H, q0=q0).q
+    assert np.max(np.abs(c - py)) <= 1e-13
+    assert e.ops["mul"] == 76 + 15 * 9 and e.ops["add"] == 65 + 9 * 9
+    with pytest.raises(ValueError, match="CoefficientSet"):
+        generate_coefficient_set("finite-amplitude")
