@@ -162,23 +162,61 @@ _GM_RATIO = 0.00344978650684  # m = ω² a² b / GM
 
 
 @njit(cache=True, inline="always")
-def _earth(lat, hgt, out):
-    """out = (R_N + h, R_E + h, γ(L, h)): meridian and transverse radii, Somigliana gravity
-    with the second-order height correction."""
-    s2 = np.sin(lat) ** 2
-    d = 1.0 - _E2 * s2
-    out[0] = _A * (1.0 - _E2) / (d * np.sqrt(d)) + hgt
-    out[1] = _A / np.sqrt(d) + hgt
-    g0 = _GE * (1.0 + _GK * s2) / np.sqrt(d)
-    out[2] = g0 * (1.0 - 2.0 / _A * (1.0 + _F + _GM_RATIO - 2.0 * _F * s2) * hgt
-                   + 3.0 * hgt * hgt / (_A * _A))
-
-
-@njit(cache=True, inline="always")
 def _cross(a, b, out):
     out[0] = a[1] * b[2] - a[2] * b[1]
     out[1] = a[2] * b[0] - a[0] * b[2]
     out[2] = a[0] * b[1] - a[1] * b[0]
+
+
+@njit(cache=True, inline="always")
+def _rates(lat, hgt, v, out):
+    """out[0:3] = ω_in, out[3:6] = γ − (ω_ie + ω_in) × v (gravity and Coriolis),
+    out[6:9] = (L̇, λ̇, ḣ) at the state (lat, hgt, v)."""
+    s = np.sin(lat)
+    cl = np.cos(lat)
+    s2 = s * s
+    d = 1.0 - _E2 * s2
+    sq = np.sqrt(d)
+    e0 = _A * (1.0 - _E2) / (d * sq) + hgt
+    e1 = _A / sq + hgt
+    g0 = _GE * (1.0 + _GK * s2) / sq
+    gam = g0 * (1.0 - 2.0 / _A * (1.0 + _F + _GM_RATIO - 2.0 * _F * s2) * hgt
+                + 3.0 * hgt * hgt / (_A * _A))
+    wie0 = _OMEGA * cl
+    wie2 = -_OMEGA * s
+    out[0] = wie0 + v[1] / e1
+    out[1] = -v[0] / e0
+    out[2] = wie2 - v[1] * (s / cl) / e1
+    w0 = wie0 + out[0]
+    w1 = out[1]
+    w2 = wie2 + out[2]
+    out[3] = -(w1 * v[2] - w2 * v[1])
+    out[4] = -(w2 * v[0] - w0 * v[2])
+    out[5] = gam - (w0 * v[1] - w1 * v[0])
+    out[6] = v[0] / e0
+    out[7] = v[1] / (e1 * cl)
+    out[8] = -v[2]
+
+
+@njit(cache=True, inline="always")
+def _am(k, a, b, c, d):
+    """Adams–Moulton mean over an update from the values at its end (a) and at the k − 1
+    updates before (b, c, d): k = 2 trapezoid, 3 and 4 the three- and four-point rules."""
+    if k == 2:
+        return 0.5 * (a + b)
+    if k == 3:
+        return (5.0 * a + 8.0 * b - c) / 12.0
+    return (9.0 * a + 19.0 * b - 5.0 * c + d) / 24.0
+
+
+@njit(cache=True, inline="always")
+def _extrap(k, b, c, d):
+    """The value at the update's end extrapolated from the k − 1 before (b, c, d)."""
+    if k == 2:
+        return b
+    if k == 3:
+        return 2.0 * b - c
+    return 3.0 * b - 3.0 * c + d
 
 
 @njit(cache=True)
@@ -194,19 +232,17 @@ def earth_nav_kernel(phi, dvb, period, lat0, lon0, h0, v0, q0, pos_out, v_out, q
     pos_out[0, 2] = h0
     v_out[0, :] = v0
     q_out[0, :] = q0
-    earth_nav_chunk_kernel(phi, dvb, period, pos_out[0], v_out[0], False, pos_out, v_out, q_out)
+    hist = np.zeros((3, 12))
+    earth_nav_chunk_kernel(phi, dvb, period, hist, 0, pos_out, v_out, q_out)
 
 
 @njit(cache=True)
-def earth_nav_chunk_kernel(phi, dvb, period, pos_prev, v_prev, has_prev, pos_out, v_out,
-                           q_out):
+def earth_nav_chunk_kernel(phi, dvb, period, hist, nh, pos_out, v_out, q_out):
     """:func:`earth_nav_kernel` continuing a run: rows 0 of the outputs hold the state the
-    chunk starts from (filled by the caller), ``pos_prev``, ``v_prev`` the state one update
-    before it, used for the mid-interval extrapolation of the first update when
-    ``has_prev`` (a run's first update has none and takes its own state)."""
-    e = np.empty(3)
-    wie = np.empty(3)
-    win = np.empty(3)
+    chunk starts from (filled by the caller); ``hist`` (3, 12) the Earth rates
+    (:func:`_rates`, columns 0–8) and the navigation-frame specific-force increment
+    (columns 9–11) at the last ``nh`` updates, newest first, updated in place (``nh = 0``:
+    a run's start). Returns the new ``nh``."""
     zeta = np.empty(3)
     x = np.empty(3)
     an = np.empty(3)
@@ -214,36 +250,24 @@ def earth_nav_chunk_kernel(phi, dvb, period, pos_prev, v_prev, has_prev, pos_out
     t2 = np.empty(3)
     t3 = np.empty(3)
     t4 = np.empty(3)
-    wsum = np.empty(3)
-    cor = np.empty(3)
-    vm = np.empty(3)
+    t5 = np.empty(3)
+    dx = np.empty(3)
+    pred = np.empty(9)
+    end = np.empty(9)
+    pp = np.empty(3)
     qb = np.empty(4)
+    if nh == 0:
+        _rates(pos_out[0, 0], pos_out[0, 2], v_out[0], hist[0])
+        nh = 1
     for m in range(phi.shape[0]):
         p = pos_out[m]
         v = v_out[m]
-        if m > 0:
-            pp = pos_out[m - 1]
-            vp = v_out[m - 1]
-        elif has_prev:
-            pp = pos_prev
-            vp = v_prev
-        else:
-            pp = p
-            vp = v
-        # mid-interval position and velocity, extrapolated from the last two updates
-        lat = 1.5 * p[0] - 0.5 * pp[0]
-        hgt = 1.5 * p[2] - 0.5 * pp[2]
+        k = nh + 1  # points of the quadrature: this update's end and nh before
+        for c in range(9):
+            pred[c] = _extrap(k, hist[0, c], hist[1, c], hist[2, c])
+        # navigation-frame rotation over the update, ζ = ∫ ω_in dt
         for c in range(3):
-            vm[c] = 1.5 * v[c] - 0.5 * vp[c]
-        _earth(lat, hgt, e)
-        wie[0] = _OMEGA * np.cos(lat)
-        wie[1] = 0.0
-        wie[2] = -_OMEGA * np.sin(lat)
-        win[0] = wie[0] + vm[1] / e[1]
-        win[1] = -vm[0] / e[0]
-        win[2] = wie[2] - vm[1] * np.tan(lat) / e[1]
-        for c in range(3):
-            zeta[c] = win[c] * period
+            zeta[c] = period * _am(k, pred[c], hist[0, c], hist[1, c], hist[2, c])
         # specific-force increment: body part rotated to n(m−1), then the frame rotation
         q = q_out[m]
         _rotate(q, dvb[m], x)
@@ -252,24 +276,37 @@ def earth_nav_chunk_kernel(phi, dvb, period, pos_prev, v_prev, has_prev, pos_out
         _cross(an, x, t2)  # α × X
         _cross(zeta, t2, t3)  # ζ × (α × X)
         _cross(zeta, t1, t4)  # ζ × (ζ × X)
-        # gravity and Coriolis at mid-interval: −(2 ω_ie + ω_en) × v = −(ω_ie + ω_in) × v
         for c in range(3):
-            wsum[c] = wie[c] + win[c]
-        _cross(wsum, vm, cor)
+            dx[c] = x[c] - hist[0, 9 + c] if nh > 1 else 0.0
+        _cross(zeta, dx, t5)  # ζ × (X_m − X_{m−1}): the specific force's change
         vn = v_out[m + 1]
         for c in range(3):
-            vn[c] = v[c] + (x[c] - 0.5 * t1[c] - t3[c] / 12.0 + t4[c] / 6.0) - cor[c] * period
-        vn[2] += e[2] * period
-        # position: trapezoid of the velocities
+            vn[c] = (v[c] + (x[c] - 0.5 * t1[c] - t3[c] / 12.0 + t4[c] / 6.0 - t5[c] / 12.0)
+                     + period * _am(k, pred[3 + c], hist[0, 3 + c], hist[1, 3 + c],
+                                    hist[2, 3 + c]))
+        # predicted position, the rates at the update's end, then the correction
+        for c in range(3):
+            pp[c] = p[c] + period * _am(k, pred[6 + c], hist[0, 6 + c], hist[1, 6 + c],
+                                        hist[2, 6 + c])
+        _rates(pp[0], pp[2], vn, end)
+        w = 0.5 if k == 2 else (5.0 / 12.0 if k == 3 else 0.375)
+        for c in range(3):
+            vn[c] += period * w * (end[3 + c] - pred[3 + c])
         pn = pos_out[m + 1]
-        pn[2] = p[2] - 0.5 * (v[2] + vn[2]) * period
-        pn[0] = p[0] + 0.5 * (v[0] + vn[0]) * period / e[0]
-        pn[1] = p[1] + 0.5 * (v[1] + vn[1]) * period / (e[1] * np.cos(lat))
+        for c in range(3):
+            pn[c] = p[c] + period * _am(k, end[6 + c], hist[0, 6 + c], hist[1, 6 + c],
+                                        hist[2, 6 + c])
+        hist[2, :] = hist[1, :]
+        hist[1, :] = hist[0, :]
+        hist[0, :9] = end
+        hist[0, 9:] = x
+        nh = min(nh + 1, 3)
         # attitude: q_m = q(ζ)* ⊗ q_{m−1} ⊗ q(φ)
         _update(q, phi[m], qb)
         for c in range(3):
             zeta[c] = -zeta[c]
         _left_update(zeta, qb, q_out[m + 1])
+    return nh
 
 
 @njit(cache=True, inline="always")

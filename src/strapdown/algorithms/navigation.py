@@ -5,17 +5,27 @@ update structure's rate with the coning and sculling corrections of
 Per update of period ``T`` with body increments ``φ``, ``Δv_b`` (:func:`body_increments`)
 and the state at ``t_{m−1}``:
 
-* mid-interval latitude, height and velocity extrapolated from the last two updates;
-  ``ω_in = ω_ie + ω_en`` there (WGS-84 radii, :mod:`strapdown.truth.earth`),
-  ``ζ = ω_in T``;
+* the Earth rates ``r = (ω_in, γ − (ω_ie + ω_in) × v, L̇, λ̇, ḣ)`` (WGS-84 radii, normal
+  gravity by Somigliana with the height correction, :mod:`strapdown.truth.earth`) are kept
+  at the last three updates; their value at ``t_m`` is extrapolated (quadratically), and
+  every Earth term is integrated over the update by the Adams–Moulton rule of the four
+  points ``t_{m−3} … t_m``, ``T (9 r_m + 19 r_{m−1} − 5 r_{m−2} + r_{m−3})/24`` (the two-
+  and three-point rules at a run's first two updates): ``ζ = ∫ ω_in dt``;
 * specific-force increment ``X = C_{m−1} Δv_b``, ``Δv_SF = X − ½ ζ × X − (1/12) ζ × (α × X)
-  + ⅙ ζ × (ζ × X)`` (``α = C_{m−1} φ``): the navigation-frame rotation to second order,
-  consistent with the body's ``½ α × υ + ⅙ α × (α × υ)`` so that a vehicle at rest on the
-  Earth (``α = ζ``) integrates exactly;
-* ``v_m = v_{m−1} + Δv_SF + [γ − (2 ω_ie + ω_en) × v] T`` (normal gravity, Somigliana with
-  the height correction);
-* latitude, longitude and height by the trapezoid of ``v_{m−1}``, ``v_m``;
+  + ⅙ ζ × (ζ × X) − (1/12) ζ × (X − X_{m−1})`` (``α = C_{m−1} φ``): the navigation-frame
+  rotation to second order, consistent with the body's ``½ α × υ + ⅙ α × (α × υ)`` so that
+  a vehicle at rest on the Earth (``α = ζ``) integrates exactly, and the last term the
+  first-order change of the specific force over the update (Savage (1998b)'s velocity
+  rotation integral for a linearly varying specific force);
+* ``v_m = v_{m−1} + Δv_SF + ∫ [γ − (2 ω_ie + ω_en) × v] dt``, the latitude, longitude and
+  height predicted with the extrapolated rates, the rates evaluated at the predicted
+  ``t_m`` state, the gravity–Coriolis integral corrected with them (predictor–corrector),
+  and the position integrated by the same rule with them;
 * ``q_m = q(−ζ) ⊗ q_{m−1} ⊗ q(φ)``.
+
+The Earth terms are thus integrated to fourth order; the navigation's order is that of
+the body increments (on a smooth manoeuvre: second for N = 1, third for N ≥ 2, see
+``strapdown reproduce sculling``).
 
 :class:`NavStream` runs the same update over a log fed in chunks, equal to
 :func:`navigate` bit for bit whatever the chunking.
@@ -116,7 +126,7 @@ class NavStream:
     conventional structure keeps a tail of fewer than N samples for the next chunk and
     the previous update's samples for the running two-sample sculling; the single chain
     keeps the last N − 1 samples (its pair terms reach N − 1 back); the navigation state
-    keeps the update before the last for the mid-interval extrapolation.
+    keeps the Earth rates of the last three updates.
 
     Parameters are those of :func:`navigate`; ``t0`` is the time of the initial state.
     """
@@ -134,7 +144,8 @@ class NavStream:
         self.update_period = self.n * self.h if structure == "conventional" else self.h
         self._pos = np.array([lat, lon, height])
         self._v, self._q = v, q
-        self._prev: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None
+        self._hist = np.zeros((3, 12))  # Earth rates of the last updates (the kernel's)
+        self._nh = 0
         self._ctx = (_Z3, _Z3)  # samples before the chunk the next one needs as context
         self._pending = (_Z3, _Z3)  # conventional: samples short of a whole update
         self._t0 = float(finite_array(t0, "t0"))
@@ -177,12 +188,9 @@ class NavStream:
         pos[0], v[0], q[0] = self._pos, self._v, self._q
         if m:
             assert body is not None
-            prev = self._prev if self._prev is not None else (pos[0], v[0])
-            _nav_kernels.earth_nav_chunk_kernel(np.ascontiguousarray(body[0]),
-                                                np.ascontiguousarray(body[1]),
-                                                self.update_period, prev[0], prev[1],
-                                                self._prev is not None, pos, v, q)
-            self._prev = (pos[-2].copy(), v[-2].copy())
+            self._nh = _nav_kernels.earth_nav_chunk_kernel(
+                np.ascontiguousarray(body[0]), np.ascontiguousarray(body[1]),
+                self.update_period, self._hist, self._nh, pos, v, q)
             self._pos, self._v, self._q = pos[-1].copy(), v[-1].copy(), q[-1].copy()
         t = self._t0 + (self._updates + 1 + np.arange(m)) * self.update_period
         self._updates += m

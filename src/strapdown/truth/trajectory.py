@@ -24,6 +24,7 @@ circle, 250 s in all) in one of its three consistent readings — the paper's
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Iterable
 from dataclasses import dataclass
@@ -273,15 +274,41 @@ class EarthState:
     q: np.ndarray
 
 
-def _ramp(s, tau, a, b):
-    """Value, rate, acceleration and integral of ``a → b`` by ``(1 − cos(π s/τ))/2``."""
+def _smoothstep(k: int) -> np.polynomial.Polynomial:
+    """The polynomial ``S`` of degree 2k + 1 rising from 0 to 1 on [0, 1] with its first k
+    derivatives zero at both ends: ``S(x) = x^(k+1) Σ_n C(k+n, n) C(2k+1, k−n) (−x)^n``."""
+    c = np.zeros(2 * k + 2)
+    for n in range(k + 1):
+        c[k + 1 + n] = math.comb(k + n, n) * math.comb(2 * k + 1, k - n) * (-1) ** n
+    return np.polynomial.Polynomial(c)
+
+
+#: C-infinity is not needed: the smooth ramp's first RAMP_SMOOTHNESS derivatives vanish at
+#: its ends, enough for the orders the navigation algorithms reach (see EarthFlight).
+RAMP_SMOOTHNESS = 8
+_S = _smoothstep(RAMP_SMOOTHNESS)
+_S1, _S2, _SI = _S.deriv(), _S.deriv(2), _S.integ()
+
+
+def _ramp(s, tau, a, b, shape="smooth"):
+    """Value, rate, acceleration and integral of ``a → b`` over ``τ``: ``(1 − cos(π s/τ))/2``
+    (``shape="cosine"``, its second derivative jumps at the ends) or the smoothstep ``S``
+    (``"smooth"``, :data:`RAMP_SMOOTHNESS` derivatives continuous)."""
     s = np.asarray(s, dtype=np.float64)
-    x = np.pi * np.minimum(s, tau) / tau
     on = s < tau
-    val = np.where(on, a + (b - a) * (1 - np.cos(x)) / 2, b)
-    rate = np.where(on, (b - a) * np.pi / (2 * tau) * np.sin(x), 0.0)
-    acc = np.where(on, (b - a) * (np.pi / tau) ** 2 / 2 * np.cos(x), 0.0)
-    ramp_int = a * np.minimum(s, tau) + (b - a) / 2 * (np.minimum(s, tau) - tau / np.pi * np.sin(x))
+    if shape == "cosine":
+        x = np.pi * np.minimum(s, tau) / tau
+        val = np.where(on, a + (b - a) * (1 - np.cos(x)) / 2, b)
+        rate = np.where(on, (b - a) * np.pi / (2 * tau) * np.sin(x), 0.0)
+        acc = np.where(on, (b - a) * (np.pi / tau) ** 2 / 2 * np.cos(x), 0.0)
+        ramp_int = a * np.minimum(s, tau) + (b - a) / 2 * (np.minimum(s, tau)
+                                                           - tau / np.pi * np.sin(x))
+    else:
+        x = np.minimum(s, tau) / tau
+        val = np.where(on, a + (b - a) * _S(x), b)
+        rate = np.where(on, (b - a) / tau * _S1(x), 0.0)
+        acc = np.where(on, (b - a) / tau**2 * _S2(x), 0.0)
+        ramp_int = a * np.minimum(s, tau) + (b - a) * tau * _SI(x)
     integral = ramp_int + b * np.maximum(s - tau, 0.0)
     return val, rate, acc, integral
 
@@ -289,12 +316,19 @@ def _ramp(s, tau, a, b):
 class EarthFlight:
     """A flight over the WGS-84 Earth: legs of constant speed with smooth turns and climbs.
 
-    The heading rate and the flight-path angle ramp between legs over ``ramp`` s; the body
-    banks as in a coordinated turn (``tan φ = V ψ̇ / g0``) and pitches with the flight
-    path (``θ = γ``); ``C_n_b = Rz(ψ) Ry(θ) Rx(φ)`` (NED, z-y-x). Heading, attitude,
+    The heading rate and the flight-path angle ramp between legs over ``ramp`` s, by the
+    smoothstep polynomial of degree 17 (``ramp_shape="smooth"``, the default: its first
+    :data:`RAMP_SMOOTHNESS` derivatives vanish at the ramp's ends, so the body rates and
+    specific force have no kink a navigation algorithm of order ≤ 8 could see) or by
+    ``(1 − cos(π s/τ))/2`` (``"cosine"``, the shape before: its second derivative jumps at
+    the ends, a kink in the body rates that caps the navigation error's order at two);
+    the body banks as in a coordinated turn (``tan φ = V ψ̇ / g0``) and pitches with the
+    flight path (``θ = γ``); ``C_n_b = Rz(ψ) Ry(θ) Rx(φ)`` (NED, z-y-x). Heading, attitude,
     velocity and their rates are closed forms; latitude, longitude and height come from
-    adaptive integration (DOP853, rtol 1e-12) of ``L̇ = v_N/(R_N + h)``,
-    ``λ̇ = v_E/((R_E + h) cos L)``, ``ḣ = −v_D``. Ideal gyro and accelerometer increments
+    adaptive integration (DOP853, rtol 1e-13, atol 1e-18) of the displacement from the
+    start (so that the tolerance bounds it, not the latitude: 1e-13 of 10 km rather than of
+    0.8 rad), ``L̇ = v_N/(R_N + h)``, ``λ̇ = v_E/((R_E + h) cos L)``, ``ḣ = −v_D``, in pieces
+    between the legs' starts and the ramps' ends. Ideal gyro and accelerometer increments
     are Gauss–Legendre quadratures (12 nodes per interval) of
     ``ω_ib = ω_nb + C_b_n (ω_ie + ω_en)`` and ``f_b = C_b_n (v̇ + (2ω_ie + ω_en) × v − γ)``
     with the normal gravity of :mod:`strapdown.truth.earth`. ``speed = 0`` is a static
@@ -302,7 +336,8 @@ class EarthFlight:
     """
 
     def __init__(self, segments, *, lat_deg: float, lon_deg: float = 0.0, height: float = 0.0,
-                 speed: float = 0.0, heading_deg: float = 0.0, ramp: float = 5.0):
+                 speed: float = 0.0, heading_deg: float = 0.0, ramp: float = 5.0,
+                 ramp_shape: Literal["smooth", "cosine"] = "smooth"):
         self.segments = tuple(segments)
         if not self.segments:
             raise ValueError("give at least one segment")
@@ -319,6 +354,9 @@ class EarthFlight:
         self.speed = float(speed)
         self.heading0 = math.radians(heading_deg)
         self.ramp = positive(ramp, "ramp")
+        if ramp_shape not in ("smooth", "cosine"):
+            raise ValueError(f"ramp_shape must be 'smooth' or 'cosine', got {ramp_shape!r}")
+        self.ramp_shape = ramp_shape
         self.starts = np.concatenate([[0.0], np.cumsum([s.duration for s in self.segments])])
         self._sol = None
 
@@ -337,11 +375,11 @@ class EarthFlight:
             r, g = math.radians(s.turn_rate_dps), math.radians(s.climb_deg)
             m = seg == i
             ds = t[m] - self.starts[i]
-            rv, ra, _, ri = _ramp(ds, self.ramp, r_prev, r)
-            gv, gr, ga, _ = _ramp(ds, self.ramp, g_prev, g)
+            rv, ra, _, ri = _ramp(ds, self.ramp, r_prev, r, self.ramp_shape)
+            gv, gr, ga, _ = _ramp(ds, self.ramp, g_prev, g, self.ramp_shape)
             for arr, val in zip(out, (psi0 + ri, rv, ra, gv, gr, ga), strict=True):
                 arr[m] = val
-            psi0 += float(_ramp(s.duration, self.ramp, r_prev, r)[3])
+            psi0 += float(_ramp(s.duration, self.ramp, r_prev, r, self.ramp_shape)[3])
             r_prev, g_prev = r, g
         return out
 
@@ -368,19 +406,26 @@ class EarthFlight:
 
             from strapdown.truth.earth import radii
 
-            def rhs(t, y):
-                v = self._velocity(np.array([t]))[0][0]
-                rn, re = radii(y[0], y[2])
-                return [v[0] / rn, v[1] / (re * np.cos(y[0])), -v[2]]
+            lat0, h0 = self.lat0, self.h0
 
-            y0, sols = [self.lat0, self.lon0, self.h0], []
-            for i in range(len(self.segments)):
-                sol = solve_ivp(rhs, (self.starts[i], self.starts[i + 1]), y0, method="DOP853",
-                                rtol=1e-12, atol=1e-15, dense_output=True)
+            def rhs(t, y):  # y: displacement from the start, so that rtol bounds it
+                v = self._velocity(np.array([t]))[0][0]
+                rn, re = radii(lat0 + y[0], h0 + y[2])
+                return [v[0] / rn, v[1] / (re * np.cos(lat0 + y[0])), -v[2]]
+
+            # pieces between the legs' starts and their ramps' ends: the manoeuvre's
+            # kinks are grid points of the integration
+            knots = np.unique(np.concatenate([self.starts, np.minimum(
+                self.starts[:-1] + self.ramp, self.starts[1:])]))
+            y0, sols = [0.0, 0.0, 0.0], []
+            for lo, hi in itertools.pairwise(knots):
+                sol = solve_ivp(rhs, (lo, hi), y0, method="DOP853", rtol=1e-13, atol=1e-18,
+                                dense_output=True)
                 if not sol.success:  # pragma: no cover
                     raise RuntimeError(f"trajectory integration failed: {sol.message}")
                 sols.append(sol)
                 y0 = sol.y[:, -1]
+            self._knots = knots
             self._sol = sols
         return self._sol
 
@@ -389,11 +434,12 @@ class EarthFlight:
         sols = self._solve()
         flat = t.ravel()
         y = np.empty((3, flat.size))
-        seg = np.clip(np.searchsorted(self.starts, flat, side="right") - 1, 0, len(sols) - 1)
+        seg = np.clip(np.searchsorted(self._knots, flat, side="right") - 1, 0, len(sols) - 1)
         for i, sol in enumerate(sols):
             m = seg == i
             if np.any(m):
                 y[:, m] = sol.sol(flat[m])
+        y += np.array([self.lat0, self.lon0, self.h0])[:, None]
         return tuple(c.reshape(t.shape) for c in y)
 
     def state(self, t) -> EarthState:
