@@ -18,6 +18,9 @@ cache says so on stderr first (:mod:`strapdown._core.compile_notice`).
 from __future__ import annotations
 
 import argparse
+import contextlib
+import os
+import signal
 import sys
 import textwrap
 
@@ -44,19 +47,28 @@ COMMANDS = (evaluate, coefficients, export_c, run, nav, compare, sweep, ahrs, be
             reproduce, bench, advise)
 
 EXIT_OK, EXIT_USAGE, EXIT_IO, EXIT_INTERRUPTED, EXIT_PIPE = 0, 2, 74, sweep.INTERRUPTED, 141
+#: An internal error (a bug; sysexits' EX_SOFTWARE) and SIGTERM (128 + 15, as a shell reports).
+EXIT_INTERNAL, EXIT_TERMINATED = 70, 128 + signal.SIGTERM
+
+#: Where an internal error asks to be reported (with the command line).
+REPORT_TO = "the strapdown issue tracker"
+#: Longest message of an internal error (characters), so one line stays one line.
+MAX_MESSAGE = 300
 
 #: Every exit status of every command and what it means (README, ``strapdown --help``).
 EXIT_STATUS = {
     EXIT_OK: "success",
-    1: "an unexpected error (a bug: the traceback is printed; please report it)",
     EXIT_USAGE: "bad input: an option, a value or an input file is wrong (one line on stderr "
     "names it; nothing is written)",
     sweep.INCOMPLETE: "sweep only: stopped by --max-cases before the grid was complete "
     "(rerun to finish)",
+    EXIT_INTERNAL: "an internal error (a bug): one line names it, please report it with the "
+    "command line; STRAPDOWN_TRACEBACK=1 prints the traceback instead",
     EXIT_IO: "a file or directory could not be read or written (one line names the path)",
     EXIT_INTERRUPTED: "interrupted (Ctrl-C); a sweep keeps its finished cases, rerun the same "
     "command to resume",
     EXIT_PIPE: "stdout closed early (e.g. piped into head); nothing more is printed",
+    EXIT_TERMINATED: "terminated (SIGTERM): as Ctrl-C, temporary files are removed",
 }
 
 #: Commands that never run a numba kernel: no compile notice (numba is not even imported).
@@ -87,16 +99,42 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, raised where the process is so that cleanup (temporary files) runs as on Ctrl-C."""
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the command line on ``argv`` (default ``sys.argv[1:]``); returns the exit status.
 
     Bad input exits with status 2 and ``strapdown COMMAND: error: …`` on stderr; Ctrl-C with
-    130 and ``strapdown COMMAND: interrupted``; an unreadable or unwritable file with 74 and
-    the path (see :data:`EXIT_STATUS`). These exits raise ``SystemExit`` as argparse does.
+    130 and ``strapdown COMMAND: interrupted``, SIGTERM likewise with 143 (both after the
+    temporary files are removed); an unreadable or unwritable file with 74 and the path; any
+    other exception (a bug) with 70 and one line asking to report it, or its traceback when
+    the environment has ``STRAPDOWN_TRACEBACK=1`` (see :data:`EXIT_STATUS`). These exits
+    raise ``SystemExit`` as argparse does.
     """
-    parser = build_parser()
+    got: list[int] = []
+
+    def on_sigterm(signum, frame) -> None:
+        got.append(signum)
+        raise Terminated()
+
+    try:
+        previous = signal.signal(signal.SIGTERM, on_sigterm)
+    except ValueError:  # not the main thread: signals stay as they are
+        previous = None
+    try:
+        return _main(argv, got)
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
+
+
+def _main(argv: list[str] | None, got: list[int]) -> int:
+    """:func:`main` once the SIGTERM handler is in place; ``got`` lists the signals received."""
     prog = "strapdown"
     try:
+        parser = build_parser()
         args = parser.parse_args(sys.argv[1:] if argv is None else argv)
         prog = f"strapdown {args.command}"
         from strapdown._core.limits import memory_budget
@@ -109,15 +147,58 @@ def main(argv: list[str] | None = None) -> int:
             with notice(say):
                 return args.handler(args)
     except ValueError as exc:
-        parser.exit(EXIT_USAGE, f"{prog}: error: {exc}\n")
+        _exit(EXIT_USAGE, f"{prog}: error: {exc}\n")
     except KeyboardInterrupt as exc:  # a sweep's says how far it got
-        parser.exit(EXIT_INTERRUPTED, f"{prog}: {str(exc) or 'interrupted'}\n")
+        status = EXIT_TERMINATED if got or isinstance(exc, Terminated) else EXIT_INTERRUPTED
+        text = str(exc) or "interrupted"
+        _exit(status, f"{prog}: {text if status == EXIT_INTERRUPTED else _terminated(text)}\n")
     except BrokenPipeError:
         _silence_stdout()
-        parser.exit(EXIT_PIPE)
+        _exit(EXIT_PIPE)
     except OSError as exc:
-        parser.exit(EXIT_IO, f"{prog}: error: {_os_error(exc)}\n")
+        _exit(EXIT_IO, f"{prog}: error: {_os_error(exc)}\n")
+    except Exception as exc:
+        if os.environ.get("STRAPDOWN_TRACEBACK", "") not in ("", "0"):
+            raise
+        _exit(EXIT_INTERNAL, f"{prog}: {_internal(exc)}\n")
     return 1  # pragma: no cover
+
+
+def _exit(status: int, message: str | None = None) -> None:
+    """Print ``message`` on stderr and raise ``SystemExit(status)`` (argparse's ``exit``)."""
+    if message:
+        with _ignored_signals():
+            sys.stderr.write(message)
+            sys.stderr.flush()
+    raise SystemExit(status)
+
+
+@contextlib.contextmanager
+def _ignored_signals():
+    """SIGINT/SIGTERM ignored while the last line is printed (a second Ctrl-C adds nothing)."""
+    try:
+        saved = {s: signal.signal(s, signal.SIG_IGN) for s in (signal.SIGINT, signal.SIGTERM)}
+    except ValueError:  # not the main thread
+        saved = {}
+    try:
+        yield
+    finally:
+        for s, h in saved.items():
+            signal.signal(s, h)
+
+
+def _terminated(text: str) -> str:
+    """The interruption line, saying it was SIGTERM."""
+    return text.replace("interrupted", "interrupted (SIGTERM)", 1)
+
+
+def _internal(exc: Exception) -> str:
+    """One bounded line naming an unexpected exception and where to report it."""
+    msg = " ".join(str(exc).split())
+    if len(msg) > MAX_MESSAGE:
+        msg = msg[:MAX_MESSAGE - 1] + "…"
+    return (f"internal error: {type(exc).__name__}: {msg}; please report it to {REPORT_TO} "
+            "with the command line (STRAPDOWN_TRACEBACK=1 shows the traceback)")
 
 
 def _os_error(exc: OSError) -> str:

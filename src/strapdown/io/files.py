@@ -1,10 +1,17 @@
-"""Atomic file output: write beside the target, then rename over it."""
+"""Atomic file output: write beside the target, then rename over it.
+
+The temporary file is ``.NAME.PID.RANDOM.SUFFIX`` beside ``NAME``: a run killed by SIGKILL
+(nothing can clean up then) leaves it behind, and the next write into the same directory removes
+every such file whose process no longer exists (:func:`remove_stale_temps`). A temporary file
+of a live process, or one without a process id (of an older version), is left alone.
+"""
 
 from __future__ import annotations
 
 import contextlib
 import errno
 import os
+import re
 import tempfile
 from pathlib import Path
 
@@ -39,8 +46,10 @@ def atomic_path(path: str | os.PathLike):
         blocker = next(p for p in path.parents if p.exists())
         raise NotADirectoryError(errno.ENOTDIR, "Not a directory (a file, where the output "
                                  "directory should be)", str(blocker)) from None
+    remove_stale_temps(path.parent)
     try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=path.suffix, dir=path.parent)
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.{os.getpid()}.", suffix=path.suffix,
+                                   dir=path.parent)
     except OSError as exc:
         raise OSError(exc.errno, exc.strerror, str(path)) from None
     os.close(fd)
@@ -54,6 +63,55 @@ def atomic_path(path: str | os.PathLike):
         if isinstance(exc, OSError) and exc.filename in (tmp, Path(tmp)):
             raise OSError(exc.errno, exc.strerror, str(path)) from None
         raise
+
+
+def _alive(pid: int) -> bool:
+    """Whether a process ``pid`` exists (one of another user's counts as alive)."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OverflowError, OSError):
+        return True
+    return True
+
+
+#: mkstemp's names as atomic_path asks for them: ``.NAME.PID.RANDOM.SUFFIX`` (RANDOM is 8 of
+#: [a-z0-9_], SUFFIX the suffix of NAME, checked in :func:`remove_stale_temps`).
+_TEMP = re.compile(r"\.(?P<name>.+)\.(?P<pid>\d+)\.[a-z0-9_]{8}(?P<suffix>(\.[^.]*)?)")
+#: (process id, directory) pairs already cleaned by this process: once per directory is
+#: enough (a killed run's temps predate this process), and a sweep writing 10^5 case files
+#: into one directory must not list it 10^5 times.
+_CLEANED: set[tuple[int, str]] = set()
+
+
+def remove_stale_temps(directory: str | os.PathLike, *, again: bool = False) -> list[Path]:
+    """Remove the temporary files in ``directory`` left by killed runs; returns those removed.
+
+    A stale file is named as :func:`atomic_path` names them, ``.NAME.PID.RANDOM.SUFFIX``
+    with SUFFIX the suffix of NAME, and ``PID`` is not this process and no longer exists.
+    Each directory is cleaned once per process unless ``again``. Errors (a file another run
+    removed first, a directory that cannot be listed) are ignored: cleaning is best effort.
+    """
+    key = (os.getpid(), os.path.abspath(directory))
+    removed: list[Path] = []
+    if key in _CLEANED and not again:
+        return removed
+    _CLEANED.add(key)
+    try:
+        entries = list(os.scandir(directory))
+    except OSError:
+        return removed
+    for entry in entries:
+        m = _TEMP.fullmatch(entry.name)
+        if (m is None or Path(m["name"]).suffix != m["suffix"] or int(m["pid"]) == os.getpid()
+                or _alive(int(m["pid"]))):
+            continue
+        with contextlib.suppress(OSError):
+            if entry.is_file(follow_symlinks=False):
+                os.unlink(entry.path)
+                removed.append(Path(entry.path))
+    return removed
 
 
 def write_text(path: str | os.PathLike, text: str) -> Path:
