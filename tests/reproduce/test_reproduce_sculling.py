@@ -35,7 +35,7 @@ def test_reduced_reproduction(tmp_path, reduced, capsys):
     assert main(["reproduce", "sculling", "--out", str(tmp_path), "--no-progress"]) == 0
     report = (tmp_path / "report.md").read_text()
     for name in ("sculling_law.png", "static.png", "flight.png", "duality.md",
-                 "sculling_realistic.md", "flight_ramp6.md"):
+                 "sculling_realistic.md", "flight_cosine.md"):
         assert (tmp_path / name).is_file(), name
         assert name in report
     assert "Skipped: smsfusion is not installed" in report
