@@ -10,11 +10,12 @@ Every run is under a memory cap (``RLIMIT_AS`` of :data:`MEMORY_CAP` set in the 
 a time limit (killed after :data:`KILL_AFTER` s). A run fails the campaign when it ends in
 an exception other than :class:`strapdown.InputError` (API), a traceback, a signal or an
 exit status other than 0, 2 and 3 (command line), takes over :data:`TIME_LIMIT` s, peaks
-over :data:`PEAK_LIMIT_MB` MB of resident memory (the worker's high-water mark, an upper
-bound of each input's own peak; a worker over it is restarted), leaves a partial output
-(any file after a failed run, a hidden temporary file after any run), or when a corpus file
-meant to be refused is read (or one meant to be read is refused). The closing table gives
-the counts per format; the exit status is 1 when anything failed.
+over :data:`PEAK_LIMIT_MB` MB of resident memory (the process's own high-water mark,
+``VmHWM``, not ``ru_maxrss``, which counts the parent's RSS at fork; for the API the worker's
+mark, an upper bound of each input's own peak; a worker over it is restarted), leaves a
+partial output (any file after a failed run, a hidden temporary file after any run), or when a
+corpus file meant to be refused is read (or one meant to be read is refused). The closing
+table gives the counts per format; the exit status is 1 when anything failed.
 """
 
 from __future__ import annotations
@@ -71,10 +72,45 @@ def _cap() -> None:
     os.setsid()
 
 
+def _own_peak_mb() -> float:
+    """This process's own peak resident memory (MB) since it was started: ``VmHWM``.
+
+    Not ``ru_maxrss``: Linux keeps the high-water mark across ``execve``, and a forked child
+    starts with its parent's resident pages, so ``ru_maxrss`` of any child is at least the
+    RSS of the process that started it (under pytest, the whole test session's ~750 MB).
+    """
+    try:
+        with open("/proc/self/status", encoding="ascii") as f:
+            for line in f:
+                if line.startswith("VmHWM:"):
+                    return int(line.split()[1]) / 1024.0
+    except (OSError, ValueError):
+        pass
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+
+
 def _peak_mb() -> float:
-    me = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-    kids = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
-    return max(me, kids) / 1024.0
+    """The worker's peak: its own, or a child's (the guarded h5py reader) — a child's
+    ``ru_maxrss`` includes the worker's RSS when it was forked, an upper bound."""
+    kids = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024.0
+    return max(_own_peak_mb(), kids)
+
+
+#: How a command line is run: ``python -m strapdown.cli`` as the console entry point runs
+#: it (``runpy``), reporting its own peak (:func:`_own_peak_mb`) into the file
+#: ``$STRAPDOWN_FUZZ_PEAK`` at exit.
+_CLI_MAIN = """\
+import atexit, os, runpy
+
+def _peak():
+    with open("/proc/self/status", encoding="ascii") as f:
+        kb = next((line.split()[1] for line in f if line.startswith("VmHWM:")), "nan")
+    with open(os.environ["STRAPDOWN_FUZZ_PEAK"], "w") as f:
+        f.write(repr(float(kb) / 1024.0))
+
+atexit.register(_peak)
+runpy.run_module("strapdown.cli", run_name="__main__", alter_sys=True)
+"""
 
 
 def _files(d: Path) -> list[str]:
@@ -240,10 +276,13 @@ def inputs(profile: dict, d: Path, seed: int) -> list[Input]:
 def run_cli(args: list[str], imu: Path, scratch: Path) -> dict:
     """One ``python -m strapdown.cli`` run under the cap; its record."""
     argv = [a.replace("{imu}", str(imu)).replace("{out}", str(scratch)) for a in args]
+    fd, peak_file = tempfile.mkstemp(prefix="fz-peak-")
+    os.close(fd)
     with tempfile.TemporaryFile() as out, tempfile.TemporaryFile() as err:
         t0 = time.perf_counter()
-        p = subprocess.Popen([sys.executable, "-m", "strapdown.cli", *argv], stdout=out,
-                             stderr=err, stdin=subprocess.DEVNULL, preexec_fn=_cap)
+        p = subprocess.Popen([sys.executable, "-c", _CLI_MAIN, *argv], stdout=out,
+                             stderr=err, stdin=subprocess.DEVNULL, preexec_fn=_cap,
+                             env={**os.environ, "STRAPDOWN_FUZZ_PEAK": peak_file})
         status, usage = None, None
         while time.perf_counter() - t0 < KILL_AFTER:
             pid, status, usage = os.wait4(p.pid, os.WNOHANG)
@@ -257,6 +296,13 @@ def run_cli(args: list[str], imu: Path, scratch: Path) -> dict:
         seconds = time.perf_counter() - t0
         err.seek(0)
         text = err.read().decode("utf-8", "replace")
+    try:  # the run's own peak; ru_maxrss (an upper bound, see _own_peak_mb) if it died
+        peak = float(Path(peak_file).read_text() or "nan")
+    except ValueError:
+        peak = float("nan")
+    os.unlink(peak_file)
+    if not peak == peak:
+        peak = usage.ru_maxrss / 1024.0 if usage else 0.0
     sig = os.WTERMSIG(status) if os.WIFSIGNALED(status) else 0
     code = os.WEXITSTATUS(status) if os.WIFEXITED(status) else None
     left = _files(scratch)
@@ -266,7 +312,7 @@ def run_cli(args: list[str], imu: Path, scratch: Path) -> dict:
         ok = False
     partial = hidden if code in (0, 3) or argv[0] == "sweep" else left
     return {"command": argv[0], "code": code, "signal": sig, "seconds": seconds,
-            "peak_mb": usage.ru_maxrss / 1024.0 if usage else 0.0, "ok": ok,
+            "peak_mb": peak, "ok": ok,
             "partial": partial, "stderr": text.strip()[-300:]}
 
 
@@ -280,6 +326,9 @@ class Tally:
     failures: list[str] = field(default_factory=list)
     slowest: float = 0.0
     peak_mb: float = 0.0
+    #: the peak of the same runs on the format's valid corpus files (imports, numba runtime:
+    #: what a trivially valid input costs); ``peak_mb`` less this is what hostile input adds
+    valid_peak_mb: float = 0.0
     cli_runs: int = 0
     cli_ok: int = 0
     cli_refused: int = 0
@@ -289,6 +338,8 @@ def _judge(t: Tally, inp: Input, rec: dict) -> None:
     t.runs += 1
     t.slowest = max(t.slowest, rec["seconds"])
     t.peak_mb = max(t.peak_mb, rec["peak_mb"])
+    if inp.origin.endswith("_valid"):
+        t.valid_peak_mb = max(t.valid_peak_mb, rec["peak_mb"])
     where = f"{inp.origin} [{rec['target']}]"
     if rec["outcome"] == "ok":
         t.ok += 1
@@ -368,6 +419,8 @@ def _cli(items: list[Input], per_format: int, tallies: dict[str, Tally], scratch
             t.cli_runs += 1
             t.slowest = max(t.slowest, rec["seconds"])
             t.peak_mb = max(t.peak_mb, rec["peak_mb"])
+            if inp.origin.endswith("_valid"):
+                t.valid_peak_mb = max(t.valid_peak_mb, rec["peak_mb"])
             where = f"{inp.origin} [strapdown {rec['command']}]"
             if not rec["ok"]:
                 t.failures.append(f"{where}: exit {rec['code']} signal {rec['signal']}: "
@@ -407,23 +460,25 @@ def campaign(profile_name: str, seed: int = 16, say=print, keep: Path | None = N
 
 
 def report(tallies: dict[str, Tally]) -> str:
-    """The closing table: counts per format, then every failure."""
+    """The closing table: counts per format, then every failure. ``peak MB``: the highest
+    peak of any run of the format; ``valid MB``: the same runs on its valid corpus files."""
     head = (f"{'format':7s} {'inputs':>7s} {'API runs':>9s} {'read':>7s} {'refused':>8s} "
             f"{'CLI runs':>9s} {'CLI ok':>7s} {'CLI exit 2':>10s} {'failures':>9s} "
-            f"{'slowest s':>10s} {'peak MB':>8s}")
+            f"{'slowest s':>10s} {'peak MB':>8s} {'valid MB':>9s}")
     lines = [head, "-" * len(head)]
     total = Counter()
     for fmt, t in tallies.items():
         lines.append(f"{fmt:7s} {t.inputs:7d} {t.runs:9d} {t.ok:7d} {t.refused:8d} "
                      f"{t.cli_runs:9d} {t.cli_ok:7d} {t.cli_refused:10d} {len(t.failures):9d} "
-                     f"{t.slowest:10.2f} {t.peak_mb:8.0f}")
+                     f"{t.slowest:10.2f} {t.peak_mb:8.0f} {t.valid_peak_mb:9.0f}")
         total.update(inputs=t.inputs, runs=t.runs, ok=t.ok, refused=t.refused, cli=t.cli_runs,
                      cli_ok=t.cli_ok, cli_refused=t.cli_refused, failures=len(t.failures))
     lines.append(f"{'total':7s} {total['inputs']:7d} {total['runs']:9d} {total['ok']:7d} "
                  f"{total['refused']:8d} {total['cli']:9d} {total['cli_ok']:7d} "
                  f"{total['cli_refused']:10d} {total['failures']:9d} "
                  f"{max(t.slowest for t in tallies.values()):10.2f} "
-                 f"{max(t.peak_mb for t in tallies.values()):8.0f}")
+                 f"{max(t.peak_mb for t in tallies.values()):8.0f} "
+                 f"{max(t.valid_peak_mb for t in tallies.values()):9.0f}")
     for fmt, t in tallies.items():
         for f in t.failures[:50]:
             lines.append(f"FAIL {fmt}: {f}")

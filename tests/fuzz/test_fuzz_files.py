@@ -77,9 +77,6 @@ def test_toml(tmp_path, data):
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(reason="measured in the final suite run: every input, valid CSV included, "
-                   "peaks at 750 MB against the 500 MB bound (the worker's own imports are "
-                   "counted); open", strict=False)
 def test_quick_campaign_has_no_failure():
     from fuzz.campaign import campaign, report
 
@@ -87,3 +84,22 @@ def test_quick_campaign_has_no_failure():
     text = report(tallies)
     assert not any(t.failures for t in tallies.values()), text
     assert sum(t.cli_runs for t in tallies.values()) >= 6
+
+
+def test_a_command_lines_peak_is_its_own_not_the_parents(tmp_path):
+    """ru_maxrss of a child includes its parent's RSS at fork (Linux keeps it across exec):
+    under a test session of ~750 MB every run seemed to peak there. The campaign measures
+    the command's own VmHWM: a run started by a process holding 512 MB stays well below."""
+    import numpy as np
+
+    from fuzz import corpus
+    from fuzz.campaign import PEAK_LIMIT_MB, run_cli
+    from fuzz.targets import CLI
+
+    imu = tmp_path / "log.csv"
+    imu.write_bytes(corpus.valid_seeds(tmp_path)["csv"])
+    (tmp_path / "out").mkdir()
+    ballast = np.ones(512 * 2**20 // 8)  # resident: every page written
+    rec = run_cli(CLI["csv"][0], imu, tmp_path / "out")
+    assert ballast.sum() == ballast.size and rec["ok"] and rec["code"] == 0, rec
+    assert 20.0 < rec["peak_mb"] < PEAK_LIMIT_MB, rec
