@@ -10,7 +10,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass, field
-from typing import Any, Literal, get_args
+from typing import TYPE_CHECKING, Any, Literal, get_args
 
 import numpy as np
 from numpy.typing import NDArray
@@ -33,18 +33,40 @@ from strapdown.analysis.law import LawResolution, judge_law
 from strapdown.truth import sensors
 from strapdown.truth.motions import ClassicalConing, KrylovMotion, Motion, PureSpin, SpinConing
 
-__all__ = ["MAX_SAMPLES", "METRICS", "MOTIONS", "Evaluation", "EvaluationConfig", "MetricName",
-           "MotionName", "build_motion", "evaluate"]
+if TYPE_CHECKING:
+    from strapdown.analysis.sculling import ScullingEvaluation
+
+__all__ = [
+    "MAX_SAMPLES",
+    "METRICS",
+    "MOTIONS",
+    "SCULLING_METRICS",
+    "Evaluation",
+    "EvaluationConfig",
+    "MetricName",
+    "MotionName",
+    "build_motion",
+    "evaluate",
+    "run_evaluation",
+]
 
 #: The reference motions an evaluation runs on (see :func:`build_motion`).
-MotionName = Literal["coning", "spin", "spin-coning", "krylov"]
+MotionName = Literal["coning", "spin", "spin-coning", "krylov", "sculling"]
 MOTIONS: tuple[MotionName, ...] = get_args(MotionName)
 #: The numerical results of an evaluation: keys of :meth:`Evaluation.to_dict` a sweep may
 #: tabulate.
 MetricName = Literal["max_error_rad", "rms_error_rad", "cone_axis_drift_rad_s",
                      "predicted_drift_rad_s", "drift_rate_rad_s", "accumulated_drift_rad",
                      "update_period_s", "samples", "chain_cone_axis_drift_rad_s",
-                     "drift_points", "measured_over_law", "law_status"]
+                     "drift_points", "measured_over_law", "law_status",
+                     "velocity_error_rate_m_s2", "predicted_velocity_error_rate_m_s2",
+                     "velocity_rate_over_law", "max_velocity_error_m_s",
+                     "max_position_error_m"]
+#: The metrics of the sculling motion (:mod:`strapdown.analysis.sculling`); the attitude
+#: metrics belong to the other motions.
+SCULLING_METRICS: tuple[MetricName, ...] = (
+    "velocity_error_rate_m_s2", "predicted_velocity_error_rate_m_s2", "velocity_rate_over_law",
+    "max_velocity_error_m_s", "max_position_error_m", "update_period_s", "samples")
 METRICS: tuple[MetricName, ...] = get_args(MetricName)
 RATE_ALGORITHMS = algorithms_taking("rate")
 #: Most samples (or computation steps) one evaluation simulates: 10⁸ increments take
@@ -63,6 +85,11 @@ class EvaluationConfig:
     means the algorithm's default: ``table3`` for ``rotvec`` (the
     classical-coning optimum), ``derived`` for the rate algorithms (the
     designer's set, quadrature error included); ``rk4`` has none.
+
+    ``motion="sculling"`` is classical sculling (:mod:`strapdown.analysis.sculling`):
+    ``angle_amplitude_deg`` θ0 about body x, ``accel_amplitude`` A (m/s²) along body y,
+    ``frequency_hz`` Ω/2π, ``phase_deg`` ψ; it runs the velocity algorithms (``rotvec``,
+    conventional or single-chain).
     """
 
     motion: MotionName = "coning"
@@ -84,6 +111,10 @@ class EvaluationConfig:
     precision: int | None = None
     gyro: sensors.GyroErrors | None = field(default=None)
     seed: int | None = None
+    angle_amplitude_deg: float = 1.0
+    accel_amplitude: float = 10.0
+    frequency_hz: float = 10.0
+    phase_deg: float = 0.0
 
     @property
     def spec(self) -> AlgorithmSpec:
@@ -105,6 +136,12 @@ class EvaluationConfig:
                 raise ValueError("arbitrary precision runs take ideal increments only")
         positive(self.sample_rate_hz, "sample rate (Hz)")
         positive(self.duration, "duration (s)")
+        if self.motion == "sculling":
+            from strapdown.analysis.sculling import validate_sculling
+
+            self._validate_limits()
+            validate_sculling(self)
+            return
         self._validate_motion()
         self._validate_limits()
 
@@ -122,6 +159,8 @@ class EvaluationConfig:
         h = 1.0 / self.sample_rate_hz
         rates = {"cone rate": 2 * math.pi * abs(self.cone_rate_hz),
                  "spin rate": math.radians(abs(self.spin_rate_dps))}
+        if self.motion == "sculling":  # validate_sculling checks the vibration
+            return
         if self.motion == "krylov":
             rates = {"krylov rate": max(abs(float(k)) for k in self.krylov_rates)}
         for what, w in rates.items():
@@ -186,7 +225,11 @@ class EvaluationConfig:
 
 
 def build_motion(cfg: EvaluationConfig) -> Motion:
-    """The reference motion a configuration names."""
+    """The reference motion a configuration names (the sculling motion:
+    :func:`strapdown.analysis.sculling.build_sculling`)."""
+    if cfg.motion == "sculling":
+        raise InputError("the sculling motion drives the velocity algorithms; evaluate it "
+                         "with strapdown.analysis.evaluate.run_evaluation")
     if cfg.motion == "krylov":
         return KrylovMotion(*map(float, cfg.krylov_rates))
     a = math.radians(cfg.half_angle_deg)
@@ -279,8 +322,21 @@ class Evaluation:
                 "exact_exp": c.exact_exp, "step_s": c.step}
 
 
+def run_evaluation(cfg: EvaluationConfig) -> Evaluation | ScullingEvaluation:
+    """:func:`evaluate`, or for ``motion="sculling"``
+    :func:`strapdown.analysis.sculling.evaluate_sculling` (what ``strapdown evaluate``,
+    ``compare`` and ``sweep`` run)."""
+    if cfg.motion == "sculling":
+        from strapdown.analysis.sculling import evaluate_sculling
+
+        cfg.validate()
+        return evaluate_sculling(cfg)
+    return evaluate(cfg)
+
+
 def evaluate(cfg: EvaluationConfig, *, coefficients: CoefficientSet | None = None) -> Evaluation:
-    """Run one configuration and analyse it.
+    """Run one configuration and analyse it (an attitude motion; the sculling motion:
+    :func:`run_evaluation`).
 
     Parameters
     ----------
