@@ -17,7 +17,7 @@ from __future__ import annotations
 import csv
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -29,45 +29,177 @@ from strapdown.algorithms.family import InputKind
 from strapdown.algorithms.finite_amplitude import TRIPLE
 from strapdown.algorithms.spec import AlgorithmSpec
 from strapdown.algorithms.structures import STRUCTURES
-from strapdown.analysis.spectrum import PAIRS, coning_spectrum, cross_spectra, predict_drift
+from strapdown.analysis.accuracy import drift_rate
+from strapdown.analysis.spectrum import (
+    PAIRS,
+    cross_spectra,
+    predict_drift,
+    predict_drift_stderr,
+)
 from strapdown.io.readers import ImuLog
+from strapdown.rotation.error import attitude_error_vector
 
-__all__ = ["PSD_COLUMNS", "Advice", "Candidate", "advise", "candidate_specs", "coning_content",
-           "log_spectrum", "read_psd", "write_figure"]
+__all__ = ["NEGLIGIBLE_DEG_H", "NEGLIGIBLE_FRACTION", "PSD_COLUMNS", "Advice", "Candidate",
+           "Reference", "advise", "candidate_specs", "coning_content", "log_reference",
+           "log_spectrum", "read_psd", "unresolved_fraction", "verified_drift_deg_h",
+           "write_figure"]
 
 #: Columns of a ``--psd`` CSV: frequency (Hz) and the imaginary parts of the one-sided
 #: cross-spectral densities G_yz, G_zx, G_xy (rad²/s²/Hz, scipy's conj(X) Y convention).
 PSD_COLUMNS = ("f_hz", "im_gyz", "im_gzx", "im_gxy")
 _RAD_S_TO_DEG_H = 180.0 / math.pi * 3600.0
+#: "No coning content" means the cheapest candidate's drift (predicted plus four standard
+#: errors of the estimate, and measured on the log when verified) stays below this fraction
+#: of the budget ...
+NEGLIGIBLE_FRACTION = 1e-3
+#: ... or, without a budget, below this drift (deg/h; about 5e-12 rad/s, well above the
+#: float64 floor of about 1e-15 rad/s measured with pure spin in reproduce high-order).
+NEGLIGIBLE_DEG_H = 1e-6
+#: Share of the rate variance below the spectrum's resolution above which an unverified
+#: spectrum cannot call a log free of coning.
+UNRESOLVED_LIMIT = 0.1
+#: Standard errors a spectral drift must exceed to count as coning.
+SIGNIFICANCE = 4.0
+
+
+#: Upsampling factor of the band-limited reference attitude (its accuracy is stated by
+#: comparing it with half of it).
+REFERENCE_UPSAMPLE = 16
+#: The reference's integrator on the upsampled increments: the single chain N = 6
+#: (drift ∝ (Ωh)^12 at the fine step; no amplitude-cubed term, see reproduce high-order).
+_REFERENCE_SPEC = "rotvec:N=6:structure=single-chain"
+#: Fraction of the log at either end left out of a verified drift (the FFT's periodic wrap).
+EDGE_FRACTION = 0.1
+
+
+@dataclass(frozen=True)
+class Reference:
+    """Band-limited reference attitude of a log at its sample times ``t`` (from 0, the log's
+    start), the window ``(t_lo, t_hi)`` drifts are measured over, and the reference's own
+    accuracy (deg/h): the drift of the half-upsampled reference against it."""
+
+    t: NDArray[np.float64]
+    q: NDArray[np.float64]
+    window: tuple[float, float]
+    upsample: int
+    accuracy_deg_h: float
+
+
+def _fine_increments(log: ImuLog, m: int) -> NDArray[np.float64]:
+    """Increments over steps ``h/m`` of the band-limited rate that reproduces the log: the
+    log (mirrored, so the periodic extension has no jump) in the FFT, each bin divided by the
+    response of its samples (an increment over ``h``, or a point sample) and multiplied by
+    that of an increment over ``h/m``, zero-padded to ``m`` times the length."""
+    x = np.concatenate([log.data, log.data[::-1]])
+    n2 = x.shape[0]
+    spec = np.fft.rfft(x, axis=0)
+    a = np.pi * np.fft.rfftfreq(n2, log.h) * log.h  # π f h
+    safe = np.where(a > 0, a, 1.0)
+    if log.kind == "increment":  # tone e^{iωt}: increment over h ∝ sin(a)/a e^{−ia}
+        resp = np.where(a > 0, np.sin(safe / m) / np.sin(safe), 1.0 / m) * np.exp(
+            -1j * a * (1 - 1.0 / m))
+    else:  # point samples at the steps' starts: an increment over h/m
+        resp = log.h / m * np.where(a > 0, np.sin(safe / m) / (safe / m), 1.0) * np.exp(
+            1j * a / m)
+    f = spec * resp[:, None]
+    if n2 % 2 == 0:
+        f[-1] *= 0.5  # the Nyquist bin is shared by ± Nyquist in the longer series
+    padded = np.zeros((n2 * m // 2 + 1, 3), dtype=np.complex128)
+    padded[:f.shape[0]] = f
+    return np.fft.irfft(padded, n2 * m, axis=0)[: log.data.shape[0] * m] * m
+
+
+def _reference_attitude(log: ImuLog, m: int) -> NDArray[np.float64]:
+    """Reference attitude at the log's sample times ``k h`` (k = 1 … n; from identity at 0)."""
+    sol = AlgorithmSpec.parse(_REFERENCE_SPEC).run_increments(_fine_increments(log, m),
+                                                              h=log.h / m)
+    idx = np.rint(sol.t / (log.h / m)).astype(np.int64)
+    q = np.full((log.data.shape[0] + 1, 4), np.nan)
+    on = idx % m == 0
+    q[idx[on] // m] = sol.q[on]
+    q[0] = (1.0, 0.0, 0.0, 0.0)
+    return q
+
+
+def log_reference(log: ImuLog, *, upsample: int = REFERENCE_UPSAMPLE) -> Reference:
+    """The band-limited reference attitude of ``log`` (see :func:`_fine_increments`),
+    integrated by the single chain N = 6 at ``h/upsample``; its accuracy is the drift of the
+    ``upsample/2`` reference against it over the window."""
+    if upsample < 4 or upsample % 2:
+        raise ValueError(f"upsample must be an even number ≥ 4, got {upsample}")
+    n = log.data.shape[0]
+    if n < 64:
+        raise ValueError(f"a verified drift needs at least 64 log samples, got {n}")
+    t = np.arange(n + 1) * log.h
+    window = (float(t[round(EDGE_FRACTION * n)]), float(t[round((1 - EDGE_FRACTION) * n)]))
+    q = _reference_attitude(log, upsample)
+    half = _reference_attitude(log, upsample // 2)
+    ok = ~np.isnan(q[:, 0]) & ~np.isnan(half[:, 0])
+    acc = _drift_deg_h(t[ok], half[ok], q[ok], window)
+    return Reference(t, q, window, upsample, acc)
+
+
+def _drift_deg_h(t: NDArray[np.float64], q: NDArray[np.float64], q_ref: NDArray[np.float64],
+                 window: tuple[float, float]) -> float:
+    """|least-squares slope| (deg/h) of ``log(q ⊗ q_ref*)`` over ``window``."""
+    tol = 1e-6 * (window[1] - window[0])  # the same samples whatever the times' round-off
+    sel = (t >= window[0] - tol) & (t <= window[1] + tol)
+    if np.count_nonzero(sel) < 2:
+        raise ValueError("fewer than two attitude outputs inside the verification window")
+    err = attitude_error_vector(q[sel], q_ref[sel])
+    return float(np.linalg.norm(drift_rate(t[sel], err).rate)) * _RAD_S_TO_DEG_H
+
+
+def verified_drift_deg_h(spec: AlgorithmSpec, log: ImuLog, ref: Reference) -> float:
+    """|drift| (deg/h) of ``spec`` run on ``log`` against the band-limited reference, over
+    the reference's window (the least-squares slope of the error)."""
+    n = log.data.shape[0]
+    if spec.input_kind == "increment":
+        sol = spec.run_increments(log.data, h=log.h)
+    else:
+        sol = spec.run_rates(np.arange(n) * log.h, log.data)
+    k = int(getattr(sol, "startup", 0))
+    idx = np.rint(sol.t[k:] / log.h).astype(np.int64)
+    keep = (idx >= 0) & (idx <= n)
+    return _drift_deg_h(ref.t[idx[keep]], sol.q[k:][keep], ref.q[idx[keep]], ref.window)
 
 
 @dataclass(frozen=True)
 class Candidate:
-    """One algorithm with its predicted drift (deg/h, norm of the drift vector) and cost."""
+    """One algorithm with its predicted drift (deg/h, norm of the drift vector), cost, and
+    the drift measured on the log against the band-limited reference (None: not verified)."""
 
     spec: AlgorithmSpec
     predicted_drift_deg_h: float
     ops_per_s: float
+    measured_drift_deg_h: float | None = None
 
     def to_dict(self) -> dict[str, object]:
         return {"spec": str(self.spec), "predicted_drift_deg_h": self.predicted_drift_deg_h,
-                "ops_per_s": self.ops_per_s}
+                "measured_drift_deg_h": self.measured_drift_deg_h, "ops_per_s": self.ops_per_s}
 
 
 @dataclass(frozen=True)
 class Advice:
-    """The ranking (lowest predicted drift first), the Pareto front and the recommendation."""
+    """The ranking (lowest predicted drift first), the Pareto front, the recommendation and
+    the coning verdict (``"detected"``, ``"absent"`` or ``"undecided"``, with its reason)."""
 
     candidates: tuple[Candidate, ...]
     pareto: tuple[str, ...]
     recommended: Candidate
     reason: str
-    coning_detected: bool
+    coning: str
+    coning_note: str
+
+    @property
+    def coning_detected(self) -> bool:
+        return self.coning == "detected"
 
     def to_dict(self) -> dict[str, object]:
         return {"candidates": [c.to_dict() for c in self.candidates],
                 "recommended": str(self.recommended.spec), "reason": self.reason,
-                "coning_detected": self.coning_detected, "pareto": list(self.pareto)}
+                "coning_detected": self.coning_detected, "coning": self.coning,
+                "coning_note": self.coning_note, "pareto": list(self.pareto)}
 
 
 def candidate_specs(kind: InputKind | None) -> list[AlgorithmSpec]:
@@ -98,6 +230,21 @@ def log_spectrum(log: ImuLog, *, nperseg: int = 256
     return f, g, max(1, 2 * rates.shape[0] // seg - 1)
 
 
+def unresolved_fraction(log: ImuLog, f: NDArray[np.float64], g: NDArray[np.complex128]
+                        ) -> float:
+    """The largest share, over the axes, of a log's rate variance that its spectrum does not
+    hold above 0 Hz (content slower than the Welch resolution, removed with the segments'
+    means): the spectrum cannot say such a log is free of coning."""
+    rates = log.data / log.h if log.kind == "increment" else log.data
+    var = np.var(rates, axis=0)
+    keep = f > 0
+    held = np.trapezoid(np.real(np.stack([g[keep, k, k] for k in range(3)], axis=-1)),
+                        f[keep], axis=0)
+    tiny = 1e-20 * (np.mean(rates, axis=0) ** 2 + var) + 1e-300
+    share = np.where(var > tiny, 1.0 - held / np.where(var > tiny, var, 1.0), 0.0)
+    return float(np.clip(np.max(share), 0.0, 1.0))
+
+
 def read_psd(path: str | Path) -> tuple[NDArray[np.float64], NDArray[np.complex128]]:
     """A ``--psd`` CSV (:data:`PSD_COLUMNS`, uniform increasing frequencies) as CSDs (F, 3, 3)
     holding the imaginary parts (the real parts do not drift an algorithm)."""
@@ -122,35 +269,60 @@ def read_psd(path: str | Path) -> tuple[NDArray[np.float64], NDArray[np.complex1
     return vals[:, 0], g
 
 
-def coning_content(f: NDArray[np.float64], g: NDArray[np.complex128],
-                   segments: int | None) -> bool:
-    """Whether the spectrum cones: some axis pair's coning power exceeds four standard
-    errors of a Welch estimate of incoherent axes (``|∫C| > 4 √(P_i P_j / segments)``); for
-    a file spectrum (``segments`` None), any coning power above 1e-12 of the rate power."""
-    c = np.atleast_1d(np.abs(np.trapezoid(coning_spectrum(g), f, axis=0)))
-    p = np.atleast_1d(np.trapezoid(np.real(np.stack([g[:, k, k] for k in range(3)], axis=-1)),
-                                   f, axis=0))
-    for col, (i, j) in enumerate(PAIRS):
-        scale = math.sqrt(max(p[i] * p[j], 0.0))
-        if segments is None:
-            if c[col] > 1e-12 * max(scale, np.max(np.abs(g.imag)) * (f[-1] - f[0])):
-                return True
-        elif scale > 0 and c[col] > 4 * scale / math.sqrt(segments):
-            return True
-    return False
+def coning_content(predicted: float, stderr: float, measured: float | None, level: float, *,
+                   segments: int | None, accuracy: float = 0.0, unresolved: float = 0.0
+                   ) -> tuple[str, str]:
+    """The coning verdict from the candidates' largest drift (deg/h; the largest predicted,
+    and the larger measured of it and the cheapest): ``"absent"`` when the
+    prediction plus :data:`SIGNIFICANCE` standard errors (and its drift measured on the log,
+    when verified) lie below the negligible ``level``; ``"detected"`` when the prediction is
+    significant or the measured drift exceeds both the level and :data:`SIGNIFICANCE` times
+    the reference's ``accuracy``; otherwise ``"undecided"`` (the log is too short, or more
+    than :data:`UNRESOLVED_LIMIT` of its rate variance lies below the spectrum's resolution
+    and no measurement speaks for it)."""
+    seg = "a file spectrum" if segments is None else f"{segments} Welch segments"
+    bound = predicted + SIGNIFICANCE * stderr
+    blind = measured is None and unresolved > UNRESOLVED_LIMIT
+    if bound <= level and (measured is None or measured <= level) and not blind:
+        return "absent", (f"no coning content: every algorithm's drift is below the "
+                          f"negligible {level:.3g} deg/h (predicted {predicted:.3g} + "
+                          f"{SIGNIFICANCE:g}σ = {bound:.3g} from {seg}" + (
+                              "" if measured is None else f"; measured {measured:.3g}") + ")")
+    if measured is not None and measured > max(level, SIGNIFICANCE * accuracy):
+        return "detected", (f"coning content: an algorithm drifts {measured:.3g} "
+                            "deg/h on the log")
+    if predicted > max(level, SIGNIFICANCE * stderr):
+        return "detected", (f"coning content: the largest predicted drift "
+                            f"{predicted:.3g} deg/h exceeds {SIGNIFICANCE:g}σ ({seg})")
+    if blind:
+        return "undecided", (f"cannot decide: {unresolved:.0%} of the rates' variance lies "
+                             "below the spectrum's resolution (a longer --nperseg, or verify "
+                             "on the log); ranked as if coning")
+    return "undecided", (f"too short to decide: the largest predicted drift "
+                         f"{predicted:.3g} ± {stderr:.3g} deg/h ({seg}) is neither significant "
+                         f"nor below the negligible {level:.3g} deg/h; ranked as if coning")
 
 
 def advise(f: NDArray[np.float64], g: NDArray[np.complex128], h: float,
            specs: Sequence[AlgorithmSpec], cost: Callable[[AlgorithmSpec, float], float], *,
            budget_deg_h: float | None = None, max_ops: float | None = None,
-           coning_detected: bool = True) -> Advice:
+           segments: int | None = None, unresolved: float = 0.0,
+           measure: Callable[[AlgorithmSpec], float] | None = None, verify: int = 8,
+           accuracy_deg_h: float = 0.0) -> Advice:
     """Rank ``specs`` by the drift predicted from the CSDs ``g`` at ``f`` (Hz) for samples
-    every ``h`` seconds, with ``cost(spec, h)`` operations per second."""
+    every ``h`` seconds, with ``cost(spec, h)`` operations per second; ``segments`` the Welch
+    segments behind ``g`` (None: a file spectrum, exact). With ``measure`` (spec → drift
+    measured on the log, deg/h; reference accurate to ``accuracy_deg_h``) up to ``verify``
+    candidates are run on the log, and the recommendation must meet the budget measured too;
+    ``unresolved`` is :func:`unresolved_fraction` of the log (0 for a file spectrum).
+    """
     h = positive(h, "h (sample interval)")
     if budget_deg_h is not None:
         positive(budget_deg_h, "--budget-deg-h")
     if max_ops is not None:
         positive(max_ops, "--max-ops")
+    if verify < 0:
+        raise ValueError(f"--verify must be ≥ 0, got {verify}")
     cands = []
     for spec in specs:
         d = float(np.linalg.norm(predict_drift(spec, f, g, h))) * _RAD_S_TO_DEG_H
@@ -161,18 +333,62 @@ def advise(f: NDArray[np.float64], g: NDArray[np.complex128], h: float,
         raise ValueError(f"no candidate needs at most --max-ops {max_ops:g} operations/s "
                          f"(the cheapest needs {min(c.ops_per_s for c in cands):.3g})")
     cheapest = min(pool, key=lambda c: (c.ops_per_s, c.predicted_drift_deg_h))
-    if not coning_detected:
-        rec, why = cheapest, "no coning content in the spectrum: the cheapest algorithm"
-    elif budget_deg_h is None:
-        rec = min(pool, key=lambda c: (c.predicted_drift_deg_h, c.ops_per_s))
-        why = "no budget given: the lowest predicted drift"
+    worst = max(pool, key=lambda c: (c.predicted_drift_deg_h, -c.ops_per_s))
+    measured: dict[str, float] = {}
+    if measure is not None and verify > 0:
+        for c in (cheapest, worst):
+            measured[str(c.spec)] = measure(c.spec)
+    stderr = 0.0 if segments is None else float(np.linalg.norm(predict_drift_stderr(
+        worst.spec, f, g, h, segments))) * _RAD_S_TO_DEG_H
+    level = NEGLIGIBLE_DEG_H if budget_deg_h is None else NEGLIGIBLE_FRACTION * budget_deg_h
+    state, note = coning_content(worst.predicted_drift_deg_h, stderr,
+                                 max(measured.values()) if measured else None, level,
+                                 segments=segments, accuracy=accuracy_deg_h,
+                                 unresolved=unresolved)
+    if state == "absent":
+        rec, why = cheapest, "no coning content: the cheapest algorithm"
     else:
-        ok = [c for c in pool if c.predicted_drift_deg_h <= budget_deg_h]
-        rec = min(ok, key=lambda c: (c.ops_per_s, c.predicted_drift_deg_h)) if ok else min(
-            pool, key=lambda c: (c.predicted_drift_deg_h, c.ops_per_s))
-        why = (f"the cheapest within {budget_deg_h:g} deg/h" if ok else
-               f"none meets {budget_deg_h:g} deg/h: the lowest predicted drift")
-    return Advice(tuple(cands), _pareto(cands), rec, why, coning_detected)
+        rec, why = _choose(pool, budget_deg_h, measure if verify > 0 else None, verify,
+                           measured)
+    final = tuple(replace(c, measured_drift_deg_h=measured.get(str(c.spec))) for c in cands)
+    by = {str(c.spec): c for c in final}
+    return Advice(final, _pareto(final), by[str(rec.spec)], why, state, note)
+
+
+def _choose(pool: list[Candidate], budget: float | None,
+            measure: Callable[[AlgorithmSpec], float] | None, verify: int,
+            measured: dict[str, float]) -> tuple[Candidate, str]:
+    """The recommendation among ``pool`` (lowest predicted drift first): the cheapest within
+    the budget — predicted and, with ``measure``, measured on the log (the first ``verify``
+    candidates in that order are run; ``measured`` collects their drifts)."""
+    by_cost = sorted(pool, key=lambda c: (c.ops_per_s, c.predicted_drift_deg_h))
+    order = pool if budget is None else [c for c in by_cost if c.predicted_drift_deg_h <= budget]
+    if not order:
+        order = pool
+        head = f"none meets {budget:g} deg/h predicted: the lowest predicted drift"
+        if measure is None:
+            return pool[0], head
+    if measure is None:
+        if budget is None:
+            return pool[0], "no budget given: the lowest predicted drift"
+        return order[0], f"the cheapest within {budget:g} deg/h"
+    tried = order[:verify]
+    for c in tried:
+        key = str(c.spec)
+        if key not in measured:
+            measured[key] = measure(c.spec)
+    if budget is not None and order is not pool:
+        for c in tried:
+            if measured[str(c.spec)] <= budget:
+                return c, (f"the cheapest within {budget:g} deg/h, predicted and measured on "
+                           "the log")
+    best = min(tried, key=lambda c: (measured[str(c.spec)], c.ops_per_s))
+    if budget is None:
+        return best, (f"no budget given: the lowest measured drift of the {len(tried)} lowest "
+                      "predicted")
+    return best, (f"none of the {len(tried)} cheapest candidates predicted within "
+                  f"{budget:g} deg/h meets it measured on the log: the lowest measured drift"
+                  if order is not pool else head + " (lowest measured of those verified)")
 
 
 def _pareto(cands: Sequence[Candidate]) -> tuple[str, ...]:
