@@ -46,6 +46,13 @@ A table with ``predicted_drift_rad_s`` also gets ``measured_over_law`` and
 errors included: :mod:`strapdown.analysis.law`), so no ratio goes out without its
 meaning.
 
+A scenario on the sculling motion (``motion = "sculling"`` with ``angle_amplitude_deg``,
+``accel_amplitude``, ``frequency_hz``, ``phase_deg``; :mod:`strapdown.analysis.sculling`)
+runs velocity algorithms (``rotvec:N=…`` in the conventional or single-chain structure)
+and takes the velocity metrics (:data:`~strapdown.analysis.evaluate.SCULLING_METRICS`;
+default: the rectified velocity-error rate, the law's and their ratio); an attitude
+metric there, or a velocity metric on an attitude motion, is an InputError.
+
 Noise is common to the algorithms of one grid point (common random numbers):
 the case seed is drawn from ``SeedSequence([seed, grid_point])``. Results do
 not depend on the scheduler, the number of workers or the order of
@@ -71,7 +78,13 @@ import numpy as np
 
 from strapdown._core.errors import InputError, shown
 from strapdown.algorithms.spec import parse_spec
-from strapdown.analysis.evaluate import METRICS, EvaluationConfig, MetricName, evaluate
+from strapdown.analysis.evaluate import (
+    METRICS,
+    SCULLING_METRICS,
+    EvaluationConfig,
+    MetricName,
+    run_evaluation,
+)
 from strapdown.io.files import atomic_path, csv_table, write_text
 from strapdown.truth.sensors import GyroErrors
 
@@ -82,6 +95,9 @@ __all__ = ["FORMATS", "Case", "Scenario", "SweepInterrupted", "SweepResult", "Ta
 # Evaluation.to_dict), defined in strapdown.analysis.evaluate.
 DEFAULT_METRICS: tuple[MetricName, ...] = ("max_error_rad", "rms_error_rad",
                                            "cone_axis_drift_rad_s", "predicted_drift_rad_s")
+#: The default metrics of a scenario on the sculling motion.
+SCULLING_DEFAULT_METRICS: tuple[MetricName, ...] = (
+    "velocity_error_rate_m_s2", "predicted_velocity_error_rate_m_s2", "velocity_rate_over_law")
 #: Added to a table that has the law's drift: the ratio and its meaning (analysis.law).
 LAW_COLUMNS: tuple[MetricName, ...] = ("measured_over_law", "law_status")
 #: The table formats a finished sweep writes.
@@ -149,7 +165,8 @@ _KINDS = {"motion": "str", "half_angle_deg": "number", "cone_rate_hz": "number",
           "spin_rate_dps": "number", "sample_rate_hz": "number", "duration": "number",
           "subsamples": "int", "coefficients": "str", "structure": "str", "rk4_step": "str",
           "krylov_rates": "triple", "alpha": "number", "beta": "number", "step": "number",
-          "exact_exp": "bool", "precision": "int",
+          "exact_exp": "bool", "precision": "int", "angle_amplitude_deg": "number",
+          "accel_amplitude": "number", "frequency_hz": "number", "phase_deg": "number",
           "gyro.white_noise": "number", "gyro.bias": "vector", "gyro.gm_sigma": "vector",
           "gyro.gm_tau": "number or inf", "gyro.scale_factor": "vector",
           "gyro.misalignment": "matrix", "gyro.quantization": "number",
@@ -285,7 +302,9 @@ def load_scenario(path) -> Scenario:
             raise InputError(f"{path}: {exc}") from None
     if len(set(algorithms)) != len(algorithms):
         raise InputError(f"{path}: an algorithm spec appears twice")
-    metrics = _strings(path, doc, "metrics", list(DEFAULT_METRICS))
+    sculling = base.get("motion") == "sculling"
+    metrics = _strings(path, doc, "metrics",
+                       list(SCULLING_DEFAULT_METRICS if sculling else DEFAULT_METRICS))
     if "predicted_drift_rad_s" in metrics:  # a law in the table comes with what it means
         metrics += [m for m in LAW_COLUMNS if m not in metrics]
     bad = [m for m in metrics if m not in METRICS]
@@ -344,6 +363,7 @@ def cases(scn: Scenario) -> list[Case]:
                 cfg = EvaluationConfig(**{**cfg_fields, **parse_spec(a)}, gyro=errors, seed=seed)
                 cfg.validate()
                 _ = cfg.samples
+                _check_metrics(cfg, scn.metrics)
             except (ValueError, TypeError, OverflowError, ArithmeticError) as exc:
                 raise InputError(f"case {len(out)} ({a}, {shown(params, 120)}): {exc}"
                                  ) from None
@@ -353,11 +373,25 @@ def cases(scn: Scenario) -> list[Case]:
     return out
 
 
+def _check_metrics(cfg: EvaluationConfig, metrics: Iterable[str]) -> None:
+    """The metrics must be the motion's: velocity metrics on the sculling motion, attitude
+    metrics elsewhere (``update_period_s`` and ``samples`` on both)."""
+    velocity = set(SCULLING_METRICS) - {"update_period_s", "samples"}
+    if cfg.motion == "sculling":
+        bad = [m for m in metrics if m not in SCULLING_METRICS]
+        what = "the sculling motion has the velocity metrics " + ", ".join(SCULLING_METRICS)
+    else:
+        bad = [m for m in metrics if m in velocity]
+        what = f"the {cfg.motion} motion has no velocity metrics (those are the sculling's)"
+    if bad:
+        raise InputError(f"metric(s) {', '.join(bad)} do not apply: {what}")
+
+
 def case_metrics(case: Case) -> dict:
     """Evaluate one case's configuration; its metrics (JSON-ready), what the case store
     keeps under :attr:`Case.key` — shared by every case with that configuration. Picklable
     for workers."""
-    d = evaluate(case.config).to_dict()
+    d = run_evaluation(case.config).to_dict()
     out: dict = {}
     for m in case.metrics:
         v = d.get(m)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 
 from strapdown.cli._common import columns, log_args, log_check_args, motion_args, say
+from strapdown.cli.evaluate import sculling_args
 
 __all__ = ["add_parser", "run"]
 
@@ -27,8 +28,12 @@ def _arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--algorithms", nargs="+", required=True, metavar="SPEC",
                    help="algorithm specs, e.g. rotvec:N=3 rotvec:N=3:structure=realtime "
                    f"rate-three:structure=sliding rk4 (algorithms: {', '.join(ALGORITHMS)}; "
-                   f"keys: N, {', '.join(k for k in SPEC_KEYS if k != 'subsamples')})")
+                   f"keys: N, {', '.join(k for k in SPEC_KEYS if k != 'subsamples')}). With "
+                   "--motion sculling: velocity algorithms rotvec:N=1..6 with "
+                   "structure=conventional or single-chain, compared by their rectified "
+                   "velocity-error rate against the sculling law")
     motion_args(p, rate_default=None)
+    sculling_args(p)
     log_args(p, imu_help="compare on this log instead of a motion", required=False,
              sample_rate=False)
     log_check_args(p, saturation=False)
@@ -56,7 +61,9 @@ def run(args: argparse.Namespace) -> int:
             motion=args.motion, half_angle_deg=args.half_angle_deg,
             cone_rate_hz=args.cone_rate_hz, spin_rate_dps=args.spin_rate_dps,
             sample_rate_hz=args.sample_rate_hz or 10_000.0, duration=args.duration,
-            krylov_rates=tuple(args.krylov_rates))
+            krylov_rates=tuple(args.krylov_rates),
+            angle_amplitude_deg=args.angle_amplitude_deg, accel_amplitude=args.accel_amplitude,
+            frequency_hz=args.frequency_hz, phase_deg=args.phase_deg)
         runs = compare.compare_motion(base, args.algorithms, args.out, progress=say)
     else:
         if args.kind is None:
@@ -68,6 +75,12 @@ def run(args: argparse.Namespace) -> int:
             on_gap=args.on_gap, gap_tolerance=args.gap_tolerance, resample=args.resample,
             accept_unit_warning=args.accept_unit_warning, delimiter=args.delimiter)
     for r in runs:
+        if "velocity_error_rate_z_m_s2" in r.summary:
+            ratio = r.summary["velocity_rate_over_law"]
+            print(f"{r.label:40s} velocity rate {r.summary['velocity_error_rate_z_m_s2']:.3e} "
+                  f"m/s² (z)  law ×{'n/a' if ratio is None else f'{ratio:.4f}'}  "
+                  f"max |δv| {r.summary['max_velocity_error_m_s']:.3e} m/s")
+            continue
         print(f"{r.label:40s} max {r.summary['max_error_rad']:.3e} rad  "
               f"rms {r.summary['rms_error_rad']:.3e} rad")
     return 0

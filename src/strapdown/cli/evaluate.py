@@ -13,7 +13,7 @@ from strapdown.cli._common import (
     structure_help,
 )
 
-__all__ = ["add_parser", "run"]
+__all__ = ["add_parser", "run", "sculling_args"]
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
@@ -37,15 +37,7 @@ def _arguments(p: argparse.ArgumentParser) -> None:
     from strapdown.algorithms.spec import ALGORITHMS, REGISTRY, STRUCTURES
 
     motion_args(p)
-    sc = p.add_argument_group("sculling motion (--motion sculling)")
-    sc.add_argument("--angle-amplitude-deg", type=float, default=1.0,
-                    help="θ0, angular vibration amplitude about body x (deg)")
-    sc.add_argument("--accel-amplitude", type=float, default=10.0,
-                    help="A, linear vibration amplitude along body y (m/s²)")
-    sc.add_argument("--frequency-hz", type=float, default=10.0,
-                    help="vibration frequency Ω/2π (Hz)")
-    sc.add_argument("--phase-deg", type=float, default=0.0,
-                    help="ψ, phase of the linear vibration ahead of the angular one (deg)")
+    sculling_args(p)
     g = p.add_argument_group("algorithm")
     g.add_argument("--algorithm", choices=ALGORITHMS, default="rotvec",
                    help=algorithm_help(ALGORITHMS))
@@ -71,6 +63,19 @@ def _arguments(p: argparse.ArgumentParser) -> None:
                    help="run in arbitrary precision with DIGITS significant digits (default: "
                    "float64)")
     json_arg(p)
+
+
+def sculling_args(p: argparse.ArgumentParser) -> None:
+    """The classical-sculling motion's options (``--motion sculling``; evaluate, compare)."""
+    sc = p.add_argument_group("sculling motion (--motion sculling)")
+    sc.add_argument("--angle-amplitude-deg", type=float, default=1.0,
+                    help="θ0, angular vibration amplitude about body x (deg)")
+    sc.add_argument("--accel-amplitude", type=float, default=10.0,
+                    help="A, linear vibration amplitude along body y (m/s²)")
+    sc.add_argument("--frequency-hz", type=float, default=10.0,
+                    help="vibration frequency Ω/2π (Hz)")
+    sc.add_argument("--phase-deg", type=float, default=0.0,
+                    help="ψ, phase of the linear vibration ahead of the angular one (deg)")
 
 
 def _fmt(x, unit="") -> str:

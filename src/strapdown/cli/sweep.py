@@ -24,7 +24,12 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         "once, so an interrupted sweep resumes where it stopped. Writes OUT/results.csv and "
         "OUT/results.parquet when the grid is complete. Exit status: 0 complete, "
         f"{INCOMPLETE} when --max-cases stops it first, {INTERRUPTED} on Ctrl-C (one line "
-        "says how many cases are saved; rerun the same command to resume), 2 bad input.")
+        "says how many cases are saved; rerun the same command to resume), 2 bad input. "
+        "A scenario with motion = \"sculling\" (angle_amplitude_deg, accel_amplitude, "
+        "frequency_hz, phase_deg) sweeps velocity algorithms (rotvec:N=1..6, conventional or "
+        "single-chain) by the velocity metrics: velocity_error_rate_m_s2, "
+        "predicted_velocity_error_rate_m_s2, velocity_rate_over_law, max_velocity_error_m_s, "
+        "max_position_error_m.")
     p.set_defaults(handler=run)
     return p
 
