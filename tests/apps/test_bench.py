@@ -15,7 +15,7 @@ PEERS = {"ahrs": "ahrs-angularrate", "smsfusion": "smsfusion-strapdownins",
 
 
 def _tiny(log=None) -> list[dict]:
-    return bench.run_benchmarks(60, 20, 1, 0, 400, log=log)
+    return bench.run_benchmarks(60, 20, 1, 0, 400, nav_samples=60, log=log)
 
 
 def test_every_benchmark_announced_before_it_runs_and_missing_peers_skipped(monkeypatch):
@@ -24,7 +24,11 @@ def test_every_benchmark_announced_before_it_runs_and_missing_peers_skipped(monk
     lines: list[str] = []
     recs = _tiny(lines.append)
     skipped = {r["name"]: r for r in recs if "skipped" in r}
-    assert set(skipped) == set(PEERS.values())
+    sculling = {"smsfusion-strapdownins-sculling", "sculling-ours-over-smsfusion"}
+    assert set(skipped) == set(PEERS.values()) | sculling
+    why = f"smsfusion not installed ({bench.PEER_EXTRA})"
+    assert skipped["smsfusion-strapdownins-sculling"]["skipped"] == why
+    assert skipped["sculling-ours-over-smsfusion"]["skipped"] == why
     for package, name in PEERS.items():
         assert skipped[name]["peer"] == package and skipped[name]["samples_per_s"] is None
         assert skipped[name]["skipped"] == f"{package} not installed ({bench.PEER_EXTRA})"
@@ -50,7 +54,7 @@ def test_cli_lists_skipped_peers_and_progress_only_when_asked(monkeypatch, capsy
              "peer": "vqf", "skipped": f"vqf not installed ({bench.PEER_EXTRA})"}]
     calls = []
 
-    def fake(*args, log=None):
+    def fake(*args, nav_samples=None, log=None):
         calls.append(log)
         if log is not None:
             log("[1/1] numpy-single-pass")
@@ -65,3 +69,19 @@ def test_cli_lists_skipped_peers_and_progress_only_when_asked(monkeypatch, capsy
     assert err == "[1/1] numpy-single-pass\n"
     assert main(["bench", "--no-progress"]) == 0
     assert capsys.readouterr().err == "" and calls[-1] is None
+
+
+def test_sculling_ratio_is_ours_over_smsfusion():
+    pytest.importorskip("smsfusion")
+    recs = {r["name"]: r for r in _tiny()}
+    ours = recs["nav-sculling-N2-conventional"]["samples_per_s"]
+    sms = recs["smsfusion-strapdownins-sculling"]["samples_per_s"]
+    assert recs["sculling-ours-over-smsfusion"]["ratio"] == pytest.approx(ours / sms, rel=1e-12)
+    assert recs["smsfusion-strapdownins-sculling"]["peer"] == "smsfusion"
+
+
+def test_cli_prints_the_sculling_ratio(monkeypatch, capsys):
+    recs = [{"name": "sculling-ours-over-smsfusion", "ratio": 2500.0, "peer": "smsfusion"}]
+    monkeypatch.setattr(bench, "run_benchmarks", lambda *a, nav_samples=None, log=None: recs)
+    assert main(["bench", "--no-progress"]) == 0
+    assert "ours/smsfusion throughput 2500×" in capsys.readouterr().out

@@ -14,6 +14,14 @@ accelerometer and magnetometer updates at every output) runs on
 (VmHWM) of a 10⁸-sample stream is measured in a fresh subprocess; about
 140 MB of it is the interpreter with numpy, scipy and numba loaded.
 
+The velocity/attitude strapdown update (sculling compensation) runs on the exact classical
+sculling motion (θ0 = 1°, A = 10 m/s², 10 Hz, ψ = 0, 1200 Hz samples, no gravity;
+:func:`strapdown.truth.sculling.classical_sculling`): ours, compiled, on ``nav_samples``
+increments (conventional N = 2 and the single chain N = 2), and
+``smsfusion.StrapdownINS.update`` on ``peer_samples`` rate and specific-force samples of
+the same motion at the same rate; the record ``sculling-ours-over-smsfusion`` gives the
+throughput ratio ours (conventional N = 2) / smsfusion.
+
 With a ``log``, each benchmark announces itself (``[k/total] name``) before it
 runs. A peer that is not installed is not dropped silently: its record has
 ``skipped``, saying which package is missing and the extra that installs it.
@@ -180,6 +188,51 @@ def _peers(samples):
     ]
 
 
+#: The sculling motion of the velocity benchmarks: θ0 (rad), Ω (rad/s), A (m/s²), 1/h (Hz).
+SCULLING_BENCH = (0.017453292519943295, 2 * np.pi * 10.0, 10.0, 1200.0)
+
+
+def _sculling(nav_samples: int, peer_samples: int, repeat: int) -> list[_Job]:
+    """Jobs of the velocity/attitude update on the exact sculling motion: ours (conventional
+    and single chain, N = 2) and smsfusion's StrapdownINS (rate and specific-force samples)."""
+    from strapdown.algorithms.velocity import integrate_inertial
+    from strapdown.truth.sculling import classical_sculling
+
+    theta0, om, acc, rate = SCULLING_BENCH
+    mo, h = classical_sculling(theta0, om, acc, 0.0), 1.0 / rate
+    edges = np.arange(nav_samples + 1) * h
+    g, a = mo.increments(edges), mo.velocity_increments(edges)
+    q0 = mo.attitude(0.0)
+    jobs = [_Job(f"nav-sculling-N2-{st}", None,
+                 lambda st=st: integrate_inertial(g, a, 2, h=h, q0=q0, structure=st),
+                 nav_samples, repeat) for st in ("conventional", "single-chain")]
+    smsfusion, why = _import_peer("smsfusion")
+    pe = edges[: peer_samples + 1]
+    w, f = mo.rate(pe[:-1]), mo.specific_force(pe[:-1])
+
+    def sms():
+        ins = smsfusion.StrapdownINS(rate, np.r_[np.zeros(6), q0, np.zeros(6)], g=0.0)
+        for k in range(w.shape[0]):
+            ins.update(f[k], w[k])
+        return ins
+
+    jobs.append(_Job("smsfusion-strapdownins-sculling", "smsfusion", smsfusion and sms,
+                     w.shape[0], 1, why))
+    return jobs
+
+
+def _sculling_ratio(recs: list[dict]) -> dict:
+    """``sculling-ours-over-smsfusion``: throughput ours (conventional N = 2) / smsfusion on
+    the same sculling motion; ``skipped`` when either record has no rate."""
+    by = {r["name"]: r for r in recs}
+    ours = by.get("nav-sculling-N2-conventional", {}).get("samples_per_s")
+    sms = by.get("smsfusion-strapdownins-sculling", {})
+    rec: dict = {"name": "sculling-ours-over-smsfusion", "ratio": None, "peer": "smsfusion"}
+    if ours is None or sms.get("samples_per_s") is None:
+        return {**rec, "skipped": sms.get("skipped") or sms.get("error") or "not measured"}
+    return {**rec, "ratio": ours / sms["samples_per_s"]}
+
+
 def _record(job: _Job, floor: float | None) -> dict:
     """Time ``job`` (the floor itself when ``floor`` is None) into its record."""
     rec: dict = {"name": job.name, "samples_per_s": None, "ratio_to_numpy_pass": None,
@@ -228,8 +281,10 @@ def _stream_memory(total, structure, chunk=1 << 16):
 
 def run_benchmarks(samples: int = 10_000_000, peer_samples: int = 20_000, repeat: int = 3,
                    stream_samples: int = 100_000_000, ekf_samples: int = 1_000_000, *,
+                   nav_samples: int = 2_000_000,
                    log: Callable[[str], None] | None = None) -> list[dict]:
-    """All benchmark records (see the module docstring).
+    """All benchmark records (see the module docstring); ``nav_samples=0`` skips the
+    velocity/sculling benchmarks.
 
     ``log`` receives ``[k/total] name`` before each benchmark runs, and one line naming
     the peers that are skipped and why, before the first.
@@ -237,7 +292,8 @@ def run_benchmarks(samples: int = 10_000_000, peer_samples: int = 20_000, repeat
     say = log or (lambda _m: None)
     floor_job, ours = _ours(samples, repeat)
     jobs = [floor_job, *ours, *_peers(peer_samples), *(_ahrs(ekf_samples, repeat)
-                                                        if ekf_samples else ())]
+                                                        if ekf_samples else ()),
+            *(_sculling(nav_samples, peer_samples, repeat) if nav_samples else ())]
     streams = ("conventional", "realtime") if stream_samples else ()
     skipped = [j for j in jobs if j.fn is None]
     if skipped:
@@ -254,5 +310,7 @@ def run_benchmarks(samples: int = 10_000_000, peer_samples: int = 20_000, repeat
         done += 1
         say(f"[{done}/{total}] stream-{structure}: peak memory of {stream_samples:.0e} samples")
         recs.append(_stream_memory(stream_samples, structure))
+    if nav_samples:
+        recs.append(_sculling_ratio(recs))
     return recs
 

@@ -35,6 +35,9 @@ def _arguments(p: argparse.ArgumentParser) -> None:
                    help="samples of the streaming memory test (0 skips it)")
     p.add_argument("--ekf-samples", type=int, default=1_000_000,
                    help="samples for the AHRS EKF and its peers (0 skips them)")
+    p.add_argument("--nav-samples", type=int, default=2_000_000,
+                   help="samples of the velocity/sculling update (ours; smsfusion gets "
+                   "--peer-samples of the same motion); 0 skips them")
     p.add_argument("--repeat", type=int, default=3, help="timed runs; the best is reported")
     p.add_argument("--json", action="store_true", help="print the records as JSON")
     progress_args(p, "a line as each benchmark starts")
@@ -46,13 +49,17 @@ def run(args: argparse.Namespace) -> int:
     from strapdown.apps.bench import run_benchmarks
 
     recs = run_benchmarks(args.samples, args.peer_samples, args.repeat, args.stream_samples,
-                          args.ekf_samples, log=say if progress(args) else None)
+                          args.ekf_samples, nav_samples=args.nav_samples,
+                          log=say if progress(args) else None)
     if args.json:
         print(json.dumps(recs, indent=2))
         return 0
     print(f"{'name':34s} {'samples/s':>12s} {'× numpy pass':>13s}  peer")
     for r in recs:
-        if "peak_rss_mb" in r:
+        if "ratio" in r:
+            print(f"{r['name']:34s} " + (f"skipped: {r['skipped']}" if r["ratio"] is None
+                                         else f"ours/smsfusion throughput {r['ratio']:.0f}×"))
+        elif "peak_rss_mb" in r:
             print(f"{r['name']:34s} peak RSS {r['peak_rss_mb']:.0f} MB in {r['seconds']:.0f} s")
         elif r.get("skipped"):
             print(f"{r['name']:34s} skipped: {r['skipped']}")
