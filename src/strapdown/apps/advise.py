@@ -341,10 +341,13 @@ def advise(f: NDArray[np.float64], g: NDArray[np.complex128], h: float,
     stderr = 0.0 if segments is None else float(np.linalg.norm(predict_drift_stderr(
         worst.spec, f, g, h, segments))) * _RAD_S_TO_DEG_H
     level = NEGLIGIBLE_DEG_H if budget_deg_h is None else NEGLIGIBLE_FRACTION * budget_deg_h
+    top = max(measured, key=lambda k: measured[k]) if measured else None
     state, note = coning_content(worst.predicted_drift_deg_h, stderr,
-                                 max(measured.values()) if measured else None, level,
+                                 None if top is None else measured[top], level,
                                  segments=segments, accuracy=accuracy_deg_h,
                                  unresolved=unresolved)
+    if state == "detected" and top is not None and note.startswith("coning content: an"):
+        note = note.replace("an algorithm", top, 1)
     if state == "absent":
         rec, why = cheapest, "no coning content: the cheapest algorithm"
     else:

@@ -131,13 +131,14 @@ def run(args: argparse.Namespace) -> int:
 
 def _table(adv, ref) -> list[str]:
     """The printed ranking: predicted and (where verified) measured drift, cost, marks."""
-    lines = [f"{'':2s}{'spec':52s} {'predicted':>11s} {'measured':>11s} {'ops/s':>11s}",
-             f"{'':2s}{'':52s} {'(deg/h)':>11s} {'(deg/h)':>11s}"]
+    w = max(len(str(c.spec)) for c in adv.candidates)
+    lines = [f"{'':2s}{'spec':{w}s} {'predicted':>11s} {'measured':>11s} {'ops/s':>11s}",
+             f"{'':2s}{'':{w}s} {'(deg/h)':>11s} {'(deg/h)':>11s}"]
     for c in adv.candidates:
         mark = ("*" if c is adv.recommended else " ") + ("P" if str(c.spec) in adv.pareto
                                                          else " ")
         meas = "-" if c.measured_drift_deg_h is None else f"{c.measured_drift_deg_h:.4g}"
-        lines.append(f"{mark}{c.spec!s:52s} {c.predicted_drift_deg_h:11.4g} {meas:>11s} "
+        lines.append(f"{mark}{c.spec!s:{w}s} {c.predicted_drift_deg_h:11.4g} {meas:>11s} "
                      f"{c.ops_per_s:11.4g}")
     lines.append(adv.coning_note)
     if ref is not None:
