@@ -32,6 +32,17 @@ structures (:func:`sculling_law`).
 
 :func:`integrate_inertial` chains the increments in a non-rotating frame without gravity
 (the sculling studies); :mod:`strapdown.algorithms.navigation` on the WGS-84 Earth.
+
+Rate input (:func:`integrate_inertial_rates`): from rate and specific-force samples
+``ω_k``, ``f_k`` every ``td`` — the dual of Wang, Wang & Wang's single-period rate
+algorithm (``rate-single``, :mod:`strapdown.algorithms.rate`), an update every ``td``:
+``θ = td/2 (ω_{k−1} + ω_k)``, ``υ = td/2 (f_{k−1} + f_k)``,
+``φ = θ + c td² ω_{k−1} × ω_k``,
+``Δv_b = υ + ½ θ × υ + ⅙ θ × (θ × υ) + c td² (ω_{k−1} × f_k + f_{k−1} × ω_k)``,
+``ΔR_b = ½ td Δv_b``, with the same ``c`` for both (Ignagni (1998)'s duality):
+``derived`` c = 1/6 — the sculling law is the coning one,
+``−(11/1440) θ0 A cos ψ (Ωtd)^4``; ``paper`` c = 1/12 — ``−(1/12) θ0 A cos ψ (Ωtd)^2``
+(:func:`rate_sculling_law`, :data:`strapdown.algorithms.tables.RATE_SINGLE_DRIFT`).
 """
 
 from __future__ import annotations
@@ -59,6 +70,8 @@ __all__ = [
     "body_increments",
     "integrate_inertial",
     "integrate_inertial_mp",
+    "integrate_inertial_rates",
+    "rate_sculling_law",
     "sculling_law",
     "sculling_matrix",
     "sculling_single_chain_table",
@@ -326,3 +339,52 @@ def integrate_inertial_mp(motion, n: int, *, h: float, samples: int, digits: int
                        for p, tt in zip(ps, t, strict=True)])
     return MpInertialSolution(np.array([float(x) for x in t]), dv, dp, digits,
                               min(startup, len(t) - 1))
+
+
+def rate_sculling_law(coefficients: str = "derived") -> ScullingLaw:
+    """Classical-sculling law of the rate-input update (module docstring), ``h`` = ``td``:
+    the coning law of ``rate-single`` with the same coefficient (the duality)."""
+    if coefficients not in tables.RATE_SINGLE_DRIFT:
+        raise ValueError(f"unknown rate-input coefficients {coefficients!r}; choose one of "
+                         f"{', '.join(tables.RATE_SINGLE_DRIFT)}")
+    order, c = tables.RATE_SINGLE_DRIFT[coefficients]  # type: ignore[index]
+    return ScullingLaw(order, c)
+
+
+def integrate_inertial_rates(omega: ArrayLike, force: ArrayLike, *, td: float,
+                             coefficients: str = "derived", t0: float = 0.0,
+                             q0: ArrayLike | None = None, v0: ArrayLike | None = None,
+                             p0: ArrayLike | None = None) -> InertialSolution:
+    """Rate-input strapdown integration in a non-rotating frame without gravity.
+
+    Parameters
+    ----------
+    omega, force : array_like of shape (k, 3)
+        Angular rate (rad/s) and specific force (m/s²) samples every ``td``, k ≥ 2.
+    td : float
+        Sample interval (s); one update per interval (k − 1 updates).
+    coefficients : {"derived", "paper"}
+        ``c`` of the coning and sculling cross terms (module docstring; Wang, Wang & Wang's
+        single-period algorithm and its dual).
+
+    The solution's ``structure`` is ``"single-chain"`` (an update every sample interval),
+    ``n`` is 1.
+    """
+    w, f = _inputs(omega, force)
+    if w.shape[0] < 2:
+        raise ValueError(f"the rate-input update needs at least 2 samples, got {w.shape[0]}")
+    td = positive(td, "td (sample interval)")
+    rate_sculling_law(coefficients)  # validates the name
+    c = float(tables.RATE_SINGLE[coefficients])  # type: ignore[index]
+    q0, v0, p0 = _state(q0, v0, p0)
+    w0, w1, f0, f1 = w[:-1], w[1:], f[:-1], f[1:]
+    th, ups = 0.5 * td * (w0 + w1), 0.5 * td * (f0 + f1)
+    phi = th + c * td * td * np.cross(w0, w1)
+    dv = (ups + 0.5 * np.cross(th, ups) + np.cross(th, np.cross(th, ups)) / 6.0
+          + c * td * td * (np.cross(w0, f1) + np.cross(f0, w1)))
+    dr = 0.5 * td * dv
+    m = phi.shape[0]
+    q, v, p = np.empty((m + 1, 4)), np.empty((m + 1, 3)), np.empty((m + 1, 3))
+    _nav_kernels.inertial_kernel(phi, dv, dr, td, q0, v0, p0, q, v, p)
+    t = float(finite_array(t0, "t0")) + np.arange(m + 1) * td
+    return InertialSolution(t, q, v, p, "single-chain", 1, td, td, 0)
