@@ -347,7 +347,7 @@ def rate_sculling_law(coefficients: str = "derived") -> ScullingLaw:
     if coefficients not in tables.RATE_SINGLE_DRIFT:
         raise ValueError(f"unknown rate-input coefficients {coefficients!r}; choose one of "
                          f"{', '.join(tables.RATE_SINGLE_DRIFT)}")
-    order, c = tables.RATE_SINGLE_DRIFT[coefficients]  # type: ignore[index]
+    order, c = tables.RATE_SINGLE_DRIFT[coefficients]
     return ScullingLaw(order, c)
 
 

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 from numpy.typing import NDArray
@@ -31,6 +31,7 @@ from numpy.typing import NDArray
 from strapdown._core.errors import InputError
 from strapdown.algorithms.velocity import (
     NAV_STRUCTURES,
+    NavStructure,
     integrate_inertial,
     integrate_inertial_mp,
     sculling_law,
@@ -157,14 +158,15 @@ def _errors(cfg: EvaluationConfig, motion: ScullingMotion, h: float,
             samples: int) -> tuple[NDArray[np.float64], NDArray[np.float64],
                                    NDArray[np.float64], int, float]:
     """Output times, velocity and position errors, first steady output, update period."""
+    structure = cast(NavStructure, cfg.structure)  # validate_sculling: one of NAV_STRUCTURES
     if cfg.precision is not None:
         s = integrate_inertial_mp(motion, cfg.subsamples, h=h, samples=samples,
-                                  digits=cfg.precision, structure=cfg.structure)
+                                  digits=cfg.precision, structure=structure)
         period = h if cfg.structure == "single-chain" else cfg.subsamples * h
         return s.t, s.dv, s.dp, s.startup, period
     edges = np.arange(samples + 1) * h
     sol = integrate_inertial(motion.increments(edges), motion.velocity_increments(edges),
-                             cfg.subsamples, h=h, structure=cfg.structure,
+                             cfg.subsamples, h=h, structure=structure,
                              q0=motion.attitude(0.0))
     return (sol.t, sol.v - motion.velocity(sol.t), sol.p - motion.position(sol.t),
             sol.startup, sol.update_period)

@@ -195,7 +195,9 @@ SCULLING_BENCH = (0.017453292519943295, 2 * np.pi * 10.0, 10.0, 1200.0)
 def _sculling(nav_samples: int, peer_samples: int, repeat: int) -> list[_Job]:
     """Jobs of the velocity/attitude update on the exact sculling motion: ours (conventional
     and single chain, N = 2) and smsfusion's StrapdownINS (rate and specific-force samples)."""
-    from strapdown.algorithms.velocity import integrate_inertial
+    import functools
+
+    from strapdown.algorithms.velocity import NavStructure, integrate_inertial
     from strapdown.truth.sculling import classical_sculling
 
     theta0, om, acc, rate = SCULLING_BENCH
@@ -203,9 +205,10 @@ def _sculling(nav_samples: int, peer_samples: int, repeat: int) -> list[_Job]:
     edges = np.arange(nav_samples + 1) * h
     g, a = mo.increments(edges), mo.velocity_increments(edges)
     q0 = mo.attitude(0.0)
-    jobs = [_Job(f"nav-sculling-N2-{st}", None,
-                 lambda st=st: integrate_inertial(g, a, 2, h=h, q0=q0, structure=st),
-                 nav_samples, repeat) for st in ("conventional", "single-chain")]
+    structures: tuple[NavStructure, ...] = ("conventional", "single-chain")
+    jobs = [_Job(f"nav-sculling-N2-{st}", None, functools.partial(
+        integrate_inertial, g, a, 2, h=h, q0=q0, structure=st), nav_samples, repeat)
+        for st in structures]
     smsfusion, why = _import_peer("smsfusion")
     pe = edges[: peer_samples + 1]
     w, f = mo.rate(pe[:-1]), mo.specific_force(pe[:-1])
