@@ -129,7 +129,7 @@ def log_reference(log: ImuLog, *, upsample: int = REFERENCE_UPSAMPLE) -> Referen
         raise ValueError(f"upsample must be an even number ≥ 4, got {upsample}")
     n = log.data.shape[0]
     if n < 64:
-        raise ValueError(f"a verified drift needs at least 64 log samples, got {n}")
+        raise ValueError(f"verifying on the log needs at least 64 samples, got {n} (--no-verify)")
     t = np.arange(n + 1) * log.h
     window = (float(t[round(EDGE_FRACTION * n)]), float(t[round((1 - EDGE_FRACTION) * n)]))
     q = _reference_attitude(log, upsample)
