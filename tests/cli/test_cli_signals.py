@@ -5,10 +5,12 @@ nothing can run — removed by the next write into the same directory."""
 from __future__ import annotations
 
 import os
+import re
 import signal
 import subprocess
 import sys
 import textwrap
+import time
 from pathlib import Path
 
 import pytest
@@ -132,3 +134,66 @@ def test_stale_temps_of_live_processes_and_other_files_are_kept(tmp_path):
         assert tmp.name.startswith(f".b.csv.{os.getpid()}.") and tmp.suffix == ".csv"
         tmp.write_text("x")
     assert (tmp_path / "b.csv").read_text() == "x"
+
+
+def test_ctrl_c_while_the_kernels_compile_is_one_line(tmp_path):
+    from fuzz import corpus
+
+    imu = tmp_path / "log.csv"
+    imu.write_bytes(corpus.valid_seeds(tmp_path)["csv"])
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "cold")}  # compiles
+    proc = subprocess.Popen([sys.executable, "-m", "strapdown.cli", "run", "--imu", str(imu),
+                             "--rates", "--units", "rad/s", "--out", str(tmp_path / "o.csv")],
+                            stderr=subprocess.PIPE, stdout=subprocess.DEVNULL, text=True,
+                            env=env)
+    assert "compiling the numba kernels" in proc.stderr.readline()
+    proc.send_signal(signal.SIGINT)
+    err = proc.stderr.read()
+    assert proc.wait(timeout=120) == 130 and err == "strapdown run: interrupted\n"
+    assert not list(tmp_path.glob("o.csv*")) and not list(tmp_path.glob(".o.csv*"))
+
+
+_SCENARIO = """\
+algorithms = ["rotvec:N=2", "rotvec:N=3"]
+metrics = ["max_error_rad"]
+seed = 1
+[motion]
+motion = "coning"
+half_angle_deg = 1.0
+[sensor]
+sample_rate_hz = 2000.0
+duration = 20.0
+[grid]
+cone_rate_hz = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0]
+"gyro.white_noise" = [0.0, 1e-6, 2e-6, 3e-6]
+"""
+
+
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT])
+def test_a_signal_to_a_pooled_sweeps_process_group_is_one_line(tmp_path, sig):
+    """As a terminal's Ctrl-C or a service manager's stop: every process gets the signal.
+    The workers exit quietly (no "Process ForkPoolWorker" traceback, no hang), the parent
+    says how far it got; no temporary file is left."""
+    scn = tmp_path / "s.toml"
+    scn.write_text(_SCENARIO)
+    proc = subprocess.Popen([sys.executable, "-m", "strapdown.cli", "sweep", str(scn), "--out",
+                             str(tmp_path / "sw"), "--workers", "2", "--format", "csv"],
+                            stderr=subprocess.PIPE, stdout=subprocess.DEVNULL, text=True,
+                            start_new_session=True)
+    assert "64 cases" in proc.stderr.readline()
+    done = tmp_path / "sw" / "cases"
+    for _ in range(1200):  # until the pool has finished a case
+        if done.is_dir() and any(p.suffix == ".json" for p in done.iterdir()):
+            break
+        time.sleep(0.05)
+    os.killpg(proc.pid, sig)
+    try:
+        _, err = proc.communicate(timeout=120)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        raise
+    status = EXIT_TERMINATED if sig == signal.SIGTERM else 130
+    assert proc.returncode == status, err
+    assert re.fullmatch(r"strapdown sweep: interrupted( \(SIGTERM\))?, \d+/64 cases done; "
+                        r"rerun the same command to resume\n", err), err
+    assert not [p for p in (tmp_path / "sw").rglob(".*")]

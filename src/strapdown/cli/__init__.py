@@ -114,8 +114,11 @@ def main(argv: list[str] | None = None) -> int:
     raise ``SystemExit`` as argparse does.
     """
     got: list[int] = []
+    owner = os.getpid()
 
     def on_sigterm(signum, frame) -> None:
+        if os.getpid() != owner:  # a forked pool worker (a sweep's): exit, quietly, releasing
+            raise SystemExit(EXIT_TERMINATED)  # its locks (the pool's queues) on the way out
         got.append(signum)
         raise Terminated()
 
