@@ -1,0 +1,52 @@
+"""``strapdown ahrs`` writes the attitude and ``OUT.meta.json`` together (issue 16): when the
+metadata cannot be written, neither file is left (nor a temporary one), and an earlier pair
+is not replaced by half of a new one."""
+
+from __future__ import annotations
+
+import errno
+
+from strapdown.cli import main
+
+
+def _ahrs(tmp_path, capsys, out):
+    from fuzz import corpus
+
+    imu = tmp_path / "log.csv"
+    imu.write_bytes(corpus.valid_seeds(tmp_path)["ahrs_csv"])
+    try:
+        code = main(["ahrs", "--imu", str(imu), "--gyro-units", "rad/s", "--acc-units",
+                     "m/s2", "--out", str(out)])
+    except SystemExit as exc:
+        code = exc.code
+    return code, capsys.readouterr().err
+
+
+def test_a_failed_metadata_write_leaves_neither_file(tmp_path, capsys, monkeypatch):
+    from strapdown.apps import _logs
+
+    def full(*args, **kwargs):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    (tmp_path / "o").mkdir()
+    monkeypatch.setattr(_logs.json, "dumps", full)  # the sidecar cannot be written
+    code, err = _ahrs(tmp_path, capsys, tmp_path / "o" / "att.csv")
+    assert code == 74 and "No space left on device" in err and err.count("\n") == 1
+    assert list((tmp_path / "o").iterdir()) == []  # no attitude, no sidecar, no temp file
+
+
+def test_a_failed_metadata_write_keeps_the_earlier_pair(tmp_path, capsys, monkeypatch):
+    from strapdown.apps import _logs
+
+    out = tmp_path / "o" / "att.csv"
+    code, err = _ahrs(tmp_path, capsys, out)
+    assert code == 0, err
+    before = {p.name: p.read_bytes() for p in out.parent.iterdir()}
+    assert sorted(before) == ["att.csv", "att.csv.meta.json"]
+
+    def full(*args, **kwargs):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(_logs.json, "dumps", full)
+    assert _ahrs(tmp_path, capsys, out)[0] == 74
+    assert {p.name: p.read_bytes() for p in out.parent.iterdir()} == before
