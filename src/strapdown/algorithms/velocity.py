@@ -43,6 +43,10 @@ algorithm (``rate-single``, :mod:`strapdown.algorithms.rate`), an update every `
 ``derived`` c = 1/6 — the sculling law is the coning one,
 ``−(11/1440) θ0 A cos ψ (Ωtd)^4``; ``paper`` c = 1/12 — ``−(1/12) θ0 A cos ψ (Ωtd)^2``
 (:func:`rate_sculling_law`, :data:`strapdown.algorithms.tables.RATE_SINGLE_DRIFT`).
+``rate-three`` likewise dualises the three-period algorithm (ω, f at 0, td, 2td, 3td;
+Simpson's 3/8 rule for α and υ; the pair coefficients k_ij on ``ω_i × f_j + f_i × ω_j``),
+an update every 3 td; its sculling law is the coning law of ``rate-three``
+(:data:`strapdown.algorithms.tables.RATE_THREE_DRIFT`: derived (Ωtd)^8, paper (Ωtd)^4).
 """
 
 from __future__ import annotations
@@ -63,6 +67,7 @@ from strapdown.algorithms.structures import single_chain_table
 
 __all__ = [
     "NAV_STRUCTURES",
+    "RATE_VELOCITY_ALGORITHMS",
     "BodyIncrements",
     "InertialSolution",
     "NavStructure",
@@ -341,50 +346,87 @@ def integrate_inertial_mp(motion, n: int, *, h: float, samples: int, digits: int
                               min(startup, len(t) - 1))
 
 
-def rate_sculling_law(coefficients: str = "derived") -> ScullingLaw:
+#: The rate-input velocity algorithms: the duals of the rate-input coning algorithms of
+#: :mod:`strapdown.algorithms.rate` (module docstring).
+RATE_VELOCITY_ALGORITHMS = ("rate-single", "rate-three")
+
+
+def rate_sculling_law(coefficients: str = "derived", algorithm: str = "rate-single"
+                      ) -> ScullingLaw:
     """Classical-sculling law of the rate-input update (module docstring), ``h`` = ``td``:
-    the coning law of ``rate-single`` with the same coefficient (the duality)."""
-    if coefficients not in tables.RATE_SINGLE_DRIFT:
+    the coning law of the same rate algorithm with the same coefficients (the duality)."""
+    laws = {"rate-single": tables.RATE_SINGLE_DRIFT, "rate-three": tables.RATE_THREE_DRIFT}
+    if algorithm not in laws:
+        raise ValueError(f"unknown rate-input velocity algorithm {algorithm!r}; choose one of "
+                         f"{', '.join(RATE_VELOCITY_ALGORITHMS)}")
+    if coefficients not in laws[algorithm]:
         raise ValueError(f"unknown rate-input coefficients {coefficients!r}; choose one of "
-                         f"{', '.join(tables.RATE_SINGLE_DRIFT)}")
-    order, c = tables.RATE_SINGLE_DRIFT[coefficients]
+                         f"{', '.join(laws[algorithm])}")
+    order, c = laws[algorithm][coefficients]
     return ScullingLaw(order, c)
 
 
+def _rate_three_body(w, f, td: float, coefficients: str):
+    """Body increments of the three-period dual (an update every 3 td, samples 0 … 3m)."""
+    m = (w.shape[0] - 1) // 3
+    ws = [w[j: 3 * m + j: 3][:m] for j in range(4)]
+    fs = [f[j: 3 * m + j: 3][:m] for j in range(4)]
+    wts = [float(x) for x in tables.RATE_THREE_WEIGHTS]
+    alpha = td * sum(c * x for c, x in zip(wts, ws, strict=True))
+    ups = td * sum(c * x for c, x in zip(wts, fs, strict=True))
+    k = [float(x) for x in tables.RATE_THREE[coefficients]]  # type: ignore[index]
+    pairs = tables.RATE_THREE_PAIRS
+    beta = td * td * sum(kk * np.cross(ws[i], ws[j]) for kk, (i, j) in zip(k, pairs, strict=True))
+    scul = td * td * sum(kk * (np.cross(ws[i], fs[j]) + np.cross(fs[i], ws[j]))
+                         for kk, (i, j) in zip(k, pairs, strict=True))
+    return alpha, ups, alpha + beta, scul
+
+
 def integrate_inertial_rates(omega: ArrayLike, force: ArrayLike, *, td: float,
-                             coefficients: str = "derived", t0: float = 0.0,
-                             q0: ArrayLike | None = None, v0: ArrayLike | None = None,
+                             coefficients: str = "derived", algorithm: str = "rate-single",
+                             t0: float = 0.0, q0: ArrayLike | None = None,
+                             v0: ArrayLike | None = None,
                              p0: ArrayLike | None = None) -> InertialSolution:
     """Rate-input strapdown integration in a non-rotating frame without gravity.
 
     Parameters
     ----------
     omega, force : array_like of shape (k, 3)
-        Angular rate (rad/s) and specific force (m/s²) samples every ``td``, k ≥ 2.
+        Angular rate (rad/s) and specific force (m/s²) samples every ``td``.
     td : float
-        Sample interval (s); one update per interval (k − 1 updates).
+        Sample interval (s).
     coefficients : {"derived", "paper"}
-        ``c`` of the coning and sculling cross terms (module docstring; Wang, Wang & Wang's
-        single-period algorithm and its dual).
+        The rate algorithm's coning coefficients, used for the sculling terms too.
+    algorithm : {"rate-single", "rate-three"}
+        ``rate-single``: an update every td (k ≥ 2); ``rate-three``: Simpson's 3/8 rule and
+        the three-period pair coefficients on ω, f at 0, td, 2td, 3td, an update every 3 td
+        (k ≥ 4; a tail of fewer than three intervals is dropped). Module docstring.
 
-    The solution's ``structure`` is ``"single-chain"`` (an update every sample interval),
-    ``n`` is 1.
+    The solution's ``structure`` is ``"single-chain"`` for rate-single (an update every
+    sample interval, ``n`` 1) and ``"conventional"`` for rate-three (``n`` 3).
     """
     w, f = _inputs(omega, force)
-    if w.shape[0] < 2:
-        raise ValueError(f"the rate-input update needs at least 2 samples, got {w.shape[0]}")
+    rate_sculling_law(coefficients, algorithm)  # validates both names
+    need = 2 if algorithm == "rate-single" else 4
+    if w.shape[0] < need:
+        raise ValueError(f"{algorithm} needs at least {need} samples, got {w.shape[0]}")
     td = positive(td, "td (sample interval)")
-    rate_sculling_law(coefficients)  # validates the name
-    c = float(tables.RATE_SINGLE[coefficients])  # type: ignore[index]
     q0, v0, p0 = _state(q0, v0, p0)
-    w0, w1, f0, f1 = w[:-1], w[1:], f[:-1], f[1:]
-    th, ups = 0.5 * td * (w0 + w1), 0.5 * td * (f0 + f1)
-    phi = th + c * td * td * np.cross(w0, w1)
-    dv = (ups + 0.5 * np.cross(th, ups) + np.cross(th, np.cross(th, ups)) / 6.0
-          + c * td * td * (np.cross(w0, f1) + np.cross(f0, w1)))
-    dr = 0.5 * td * dv
+    if algorithm == "rate-single":
+        c = float(tables.RATE_SINGLE[coefficients])  # type: ignore[index]
+        w0, w1, f0, f1 = w[:-1], w[1:], f[:-1], f[1:]
+        th, ups = 0.5 * td * (w0 + w1), 0.5 * td * (f0 + f1)
+        phi = th + c * td * td * np.cross(w0, w1)
+        scul = c * td * td * (np.cross(w0, f1) + np.cross(f0, w1))
+        period, n, structure = td, 1, "single-chain"
+    else:
+        th, ups, phi, scul = _rate_three_body(w, f, td, coefficients)
+        period, n, structure = 3 * td, 3, "conventional"
+    dv = ups + 0.5 * np.cross(th, ups) + np.cross(th, np.cross(th, ups)) / 6.0 + scul
+    dr = 0.5 * period * dv
     m = phi.shape[0]
     q, v, p = np.empty((m + 1, 4)), np.empty((m + 1, 3)), np.empty((m + 1, 3))
-    _nav_kernels.inertial_kernel(phi, dv, dr, td, q0, v0, p0, q, v, p)
-    t = float(finite_array(t0, "t0")) + np.arange(m + 1) * td
-    return InertialSolution(t, q, v, p, "single-chain", 1, td, td, 0)
+    _nav_kernels.inertial_kernel(np.ascontiguousarray(phi), np.ascontiguousarray(dv),
+                                 np.ascontiguousarray(dr), period, q0, v0, p0, q, v, p)
+    t = float(finite_array(t0, "t0")) + np.arange(m + 1) * period
+    return InertialSolution(t, q, v, p, structure, n, td, period, 0)  # type: ignore[arg-type]
