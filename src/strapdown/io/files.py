@@ -93,13 +93,14 @@ def remove_stale_temps(directory: str | os.PathLike, *, again: bool = False) -> 
     Each directory is cleaned once per process unless ``again``. Errors (a file another run
     removed first, a directory that cannot be listed) are ignored: cleaning is best effort.
     """
-    key = (os.getpid(), os.path.abspath(directory))
+    folder = os.path.abspath(os.fspath(directory))
+    key = (os.getpid(), str(folder))
     removed: list[Path] = []
     if key in _CLEANED and not again:
         return removed
     _CLEANED.add(key)
     try:
-        entries = list(os.scandir(directory))
+        entries = list(os.scandir(str(folder)))
     except OSError:
         return removed
     for entry in entries:
