@@ -4,6 +4,7 @@ precision against the exact double series, and the places that refuse them."""
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from fractions import Fraction as F
 
 import numpy as np
@@ -12,7 +13,12 @@ import pytest
 from strapdown._core.backend import NUMPY
 from strapdown.algorithms import _reference
 from strapdown.algorithms.coning import coefficient_set, rotation_vectors
-from strapdown.algorithms.finite_amplitude import AMPLITUDE_LAW, TRIPLE, triple_terms
+from strapdown.algorithms.finite_amplitude import (
+    A6_DESIGN,
+    AMPLITUDE_LAW,
+    TRIPLE,
+    triple_terms,
+)
 from strapdown.algorithms.spec import AlgorithmSpec
 from strapdown.algorithms.streaming import RotvecStream
 from strapdown.algorithms.structures import (
@@ -28,12 +34,45 @@ from strapdown.design import finite_amplitude as FA
 MAKE = {"conventional": D.interval_structure, "single-chain": D.single_chain_structure}
 
 
+def _design(structure, n):
+    """The structure and design the table's entry comes from (A6_DESIGN: the a⁶ designs)."""
+    if structure == "conventional" and n in A6_DESIGN:
+        st = FA.with_a6_triples(D.interval_structure(n), through_law=A6_DESIGN[n])
+        return st, FA.derive_triple_a6(st)
+    st = FA.with_last_triples(MAKE[structure](n))
+    return st, FA.derive_triple(st)
+
+
 @pytest.mark.parametrize("structure", list(MAKE))
 def test_tables_are_the_designers(structure):
     for n in range(2, 7):
-        d = FA.derive_triple(FA.with_last_triples(MAKE[structure](n)))
-        assert TRIPLE[structure][n] == d.triple_coefficients
-        assert AMPLITUDE_LAW[structure][n] == d.amplitude_law
+        st, d = _design(structure, n)
+        assert TRIPLE[structure][n] == tuple((m, i, j, t) for (m, i, j), t
+                                             in zip(st.triples, d.triple_coefficients,
+                                                    strict=True))
+        law = AMPLITUDE_LAW[structure][n]
+        assert law[:len(d.amplitude_law)] == d.amplitude_law
+        assert len(law) == len(d.amplitude_law) + (structure == "conventional" and n == 6)
+
+
+@pytest.mark.parametrize("n", sorted(A6_DESIGN))
+def test_a6_tables_meet_their_conditions(n):
+    """The tabulated a⁶ sets themselves: a² drift that of the pair set, a⁴ zero through
+    (Ωh)^{2N+2} exactly, the cancelled a⁶ terms below 1e-20 (N = 6: and its a⁸ law term)."""
+    st, _ = _design("conventional", n)
+    pairs = D.derive(replace(st, triples=()))
+    tau = [t for *_, t in TRIPLE["conventional"][n]]
+    ser = FA.drift_series(st, pairs.coefficients, tau, x_order=2 * n + 2,
+                          a_order=8 if n == 6 else 6)
+    assert ser[2] == FA.drift_series(st, pairs.coefficients, [F(0)] * len(tau),
+                                     x_order=2 * n + 2, a_order=2)[2]
+    assert not any(ser[4])
+    cancelled = range(6, 2 * n + 1 if A6_DESIGN[n] else 2 * n - 1, 2)  # x⁶ … (N−3 or N−2)
+    assert all(abs(ser[6][q]) < 1e-20 for q in cancelled)
+    assert max(abs(t) for t in tau) < 35  # 4.27, 16.4, 34.5 for N = 4, 5, 6
+    if n == 6:
+        assert (8, 8, -ser[8][8]) == AMPLITUDE_LAW["conventional"][6][-1]
+        assert float(ser[8][8]) == pytest.approx(0.3737, abs=1e-4)
 
 
 def _theta(n, seed):
@@ -74,8 +113,7 @@ def test_single_chain_kernel_matches_reference(n):
 
 
 def _series_drift(structure, n, a, spp):
-    st = FA.with_last_triples(MAKE[structure](n))
-    d = FA.derive_triple(st)
+    st, d = _design(structure, n)
     ser = FA.drift_series(st, d.coefficients, d.triple_coefficients, x_order=2 * n + 12)
     x = 2 * math.pi / spp
     return CONE_RATE * sum(float(v) * a**p * x**q for p, row in ser.items()

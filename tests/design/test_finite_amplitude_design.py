@@ -112,9 +112,11 @@ def test_series_sums_to_the_exact_response(make, n):
 def test_design_coefficient_set_keeps_the_triple_terms():
     from strapdown.algorithms.coning import coefficient_set
 
-    d = FA.derive_triple(FA.with_last_triples(D.interval_structure(4)))
+    d = FA.derive_triple(FA.with_last_triples(D.interval_structure(3)))
     cs = d.coefficient_set("mine")
-    assert cs.triples == coefficient_set("finite-amplitude", 4).triples
+    assert cs.triples == coefficient_set("finite-amplitude", 3).triples
+    a6 = FA.derive_triple_a6(FA.with_a6_triples(D.interval_structure(4)))  # the shipped N = 4
+    assert a6.coefficient_set("mine").triples == coefficient_set("finite-amplitude", 4).triples
     with pytest.raises(ValueError, match="no triple terms"):
         d.algorithm()
 
@@ -264,8 +266,9 @@ def test_a6_design_needs_free_coefficients():
 
 def test_linear_n6_set_at_the_band_edge():
     # conventional N = 6, a = 1°, Ω = 2π, Ωh = 0.2 (the acceptance band's edge): the linear
-    # set (a⁴ only) drifts 2.79× its a² law, 9.1e-16 rad/s (just under the ~1e-15 float64
-    # floor); its a⁶ x⁶ … x¹⁰ terms (4.5e-15, −6.0e-15, 7.6e-16) are what the a⁶ set removes
+    # set (a⁴ only, shipped before the a⁶ design) drifts 2.79× its a² law, 9.1e-16 rad/s
+    # (just under the ~1e-15 float64 floor); its a⁶ x⁶ … x¹⁰ terms (4.5e-15, −6.0e-15,
+    # 7.6e-16) are what the a⁶ set, now the shipped finite-amplitude N = 6, removes
     import math
 
     from strapdown.algorithms.spec import AlgorithmSpec
@@ -273,11 +276,14 @@ def test_linear_n6_set_at_the_band_edge():
 
     a, om, x = math.radians(1.0), 2 * math.pi, 0.2
     law = -a**2 * om * x**12 / 24024
-    lin = classical_coning_drift(AlgorithmSpec.parse("rotvec:N=6:coefficients=finite-amplitude"),
-                                 a, x, cone_rate=om)
+    _, lw = _window(FA.derive_triple(FA.with_last_triples(D.interval_structure(6))))
+    lin = classical_coning_drift(lw, a, x, cone_rate=om)
     assert lin / law == pytest.approx(2.79, abs=0.01) and abs(lin) < 1e-15
     _, w = _window(FA.derive_triple_a6(FA.with_a6_triples(D.interval_structure(6))))
-    assert classical_coning_drift(w, a, x, cone_rate=om) / law == pytest.approx(1.23, abs=0.01)
+    a6 = classical_coning_drift(w, a, x, cone_rate=om)
+    assert a6 / law == pytest.approx(1.23, abs=0.01)
+    shipped = AlgorithmSpec.parse("rotvec:N=6:coefficients=finite-amplitude")
+    assert classical_coning_drift(shipped, a, x, cone_rate=om) == a6
 
 
 @pytest.mark.parametrize("n", [5, 6])
