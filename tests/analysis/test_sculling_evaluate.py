@@ -89,3 +89,20 @@ def test_attitude_evaluate_rejects_sculling():
 
     with pytest.raises(InputError, match="run_evaluation"):
         evaluate(EvaluationConfig(motion="sculling", duration=0.1))
+
+
+@pytest.mark.parametrize(("algorithm", "order", "c"),
+                         [("rate-single", 4, 11 / 1440), ("rate-three", 8, 433 / 806400)])
+def test_rate_input_duals_on_the_sculling_motion(algorithm, order, c):
+    # the rate-input duals follow the coning law of the same rate algorithm (tables)
+    cfg = EvaluationConfig(motion="sculling", algorithm=algorithm, angle_amplitude_deg=0.01,
+                           accel_amplitude=1.0, frequency_hz=1.0, phase_deg=0.0,
+                           sample_rate_hz=30.0, duration=6.0)
+    d = run_evaluation(cfg).to_dict()
+    # ψ = 0: at ψ = 20° rate-three measures 0.978× its law here (a sin ψ term of higher order)
+    law = -c * math.radians(0.01) * (2 * math.pi / 30) ** order
+    assert d["predicted_velocity_error_rate_m_s2"][2] == pytest.approx(law, rel=1e-12)
+    assert d["velocity_error_rate_m_s2"][2] / law == pytest.approx(1.0, abs=0.01)
+    assert d["coefficients"] == "derived"
+    with pytest.raises(InputError, match="float64 only"):
+        run_evaluation(EvaluationConfig(**{**cfg.__dict__, "precision": 30}))

@@ -14,7 +14,9 @@ The rectified velocity-error rate is the least-squares slope of the navigation-f
 velocity error (computed − exact) through the outputs on whole vibration periods from the
 first period on (:func:`strapdown.analysis.accuracy.drift_rate`; the periodic part and a
 start-up offset cancel); the law is ``−c · θ0 A cos ψ (Ωh)^{2N}`` along navigation z,
-``c = N!(N+1)!/(2N+2)!`` (:func:`strapdown.algorithms.velocity.sculling_law`), first order
+``c = N!(N+1)!/(2N+2)!`` (:func:`strapdown.algorithms.velocity.sculling_law`; the rate-input
+duals ``rate-single``/``rate-three`` on rate and specific-force samples, float64:
+:func:`strapdown.algorithms.velocity.rate_sculling_law`), first order
 in θ0 — at a realistic amplitude the θ0³ terms it leaves out may dominate (see
 ``strapdown reproduce sculling``).
 """
@@ -31,9 +33,12 @@ from numpy.typing import NDArray
 from strapdown._core.errors import InputError
 from strapdown.algorithms.velocity import (
     NAV_STRUCTURES,
+    RATE_VELOCITY_ALGORITHMS,
     NavStructure,
     integrate_inertial,
     integrate_inertial_mp,
+    integrate_inertial_rates,
+    rate_sculling_law,
     sculling_law,
 )
 from strapdown.analysis.accuracy import drift_rate
@@ -66,16 +71,19 @@ def validate_sculling(cfg: EvaluationConfig) -> None:
     at most :data:`MAX_MP_SCULLING_SAMPLES` samples."""
     from strapdown.algorithms.coning import MAX_SUBSAMPLES
 
-    if cfg.algorithm != "rotvec":
+    if cfg.algorithm in RATE_VELOCITY_ALGORITHMS:
+        _validate_rate(cfg)
+    elif cfg.algorithm != "rotvec":
         raise InputError(f"the sculling motion runs the velocity algorithms (rotvec, N = 1–"
-                         f"{MAX_SUBSAMPLES}); {cfg.algorithm} integrates attitude only")
-    if cfg.structure not in NAV_STRUCTURES:
+                         f"{MAX_SUBSAMPLES}; rate input: {', '.join(RATE_VELOCITY_ALGORITHMS)}"
+                         f"); {cfg.algorithm} integrates attitude only")
+    elif cfg.structure not in NAV_STRUCTURES:
         raise InputError(f"the velocity algorithms run in the {' or '.join(NAV_STRUCTURES)} "
                          f"structure, not {cfg.structure}")
-    if cfg.coefficients not in (None, "table3"):
+    elif cfg.coefficients not in (None, "table3"):
         raise InputError(f"the velocity algorithms use the designer's sets (coning: table3); "
                          f"coefficients {cfg.coefficients} do not apply to the sculling motion")
-    if not 1 <= cfg.subsamples <= MAX_SUBSAMPLES:
+    elif not 1 <= cfg.subsamples <= MAX_SUBSAMPLES:
         raise InputError(f"N (subsamples) must be 1–{MAX_SUBSAMPLES} for the velocity "
                          f"algorithms, got {cfg.subsamples}")
     if cfg.gyro is not None and not cfg.gyro.is_ideal:
@@ -98,6 +106,20 @@ def validate_sculling(cfg: EvaluationConfig) -> None:
         if cfg.samples > MAX_MP_SCULLING_SAMPLES:
             raise InputError(f"{cfg.samples} samples in arbitrary precision; at most "
                              f"{MAX_MP_SCULLING_SAMPLES} (shorten --duration or lower the rate)")
+
+
+def _validate_rate(cfg: EvaluationConfig) -> None:
+    """The rate-input duals (:func:`strapdown.algorithms.velocity.integrate_inertial_rates`):
+    their own structure only (conventional), coefficients derived or paper, float64."""
+    if cfg.structure != "conventional":
+        raise InputError(f"the rate-input velocity algorithms have one structure (an update "
+                         f"every td or 3 td), not {cfg.structure}")
+    if cfg.coefficients not in (None, "derived", "paper"):
+        raise InputError(f"coefficients {cfg.coefficients} do not apply to {cfg.algorithm}; "
+                         "choose derived or paper")
+    if cfg.precision is not None:
+        raise InputError(f"{cfg.algorithm} on the sculling motion runs in float64 only; "
+                         "drop --precision")
 
 
 def build_sculling(cfg: EvaluationConfig) -> ScullingMotion:
@@ -139,7 +161,9 @@ class ScullingEvaluation:
         c = self.config
         return {
             "motion": c.motion, "algorithm": c.algorithm, "structure": c.structure,
-            "subsamples": c.subsamples, "coefficients": "table3",
+            "subsamples": c.subsamples,
+            "coefficients": (c.coefficients or "derived") if c.algorithm != "rotvec"
+            else "table3",
             "precision_digits": c.precision,
             "angle_amplitude_deg": c.angle_amplitude_deg, "accel_amplitude_m_s2": c.accel_amplitude,
             "frequency_hz": c.frequency_hz, "phase_deg": c.phase_deg,
@@ -159,6 +183,13 @@ def _errors(cfg: EvaluationConfig, motion: ScullingMotion, h: float,
                                    NDArray[np.float64], int, float]:
     """Output times, velocity and position errors, first steady output, update period."""
     structure = cast(NavStructure, cfg.structure)  # validate_sculling: one of NAV_STRUCTURES
+    if cfg.algorithm in RATE_VELOCITY_ALGORITHMS:
+        t_s = np.arange(samples) * h
+        sol = integrate_inertial_rates(motion.rate(t_s), motion.specific_force(t_s), td=h,
+                                       coefficients=cfg.coefficients or "derived",
+                                       algorithm=cfg.algorithm, q0=motion.attitude(0.0))
+        return (sol.t, sol.v - motion.velocity(sol.t), sol.p - motion.position(sol.t), 0,
+                sol.update_period)
     if cfg.precision is not None:
         s = integrate_inertial_mp(motion, cfg.subsamples, h=h, samples=samples,
                                   digits=cfg.precision, structure=structure)
@@ -185,7 +216,9 @@ def evaluate_sculling(cfg: EvaluationConfig) -> ScullingEvaluation:
     if np.count_nonzero(sel) < 2:
         sel = np.ones(t.size, dtype=bool)
     est = drift_rate(t[sel], dv[sel], period=vib, reference_time=ref, h=period)
-    law = sculling_law(cfg.subsamples).predict(
+    rate_input = cfg.algorithm in RATE_VELOCITY_ALGORITHMS
+    law = (rate_sculling_law(cfg.coefficients or "derived", cfg.algorithm) if rate_input
+           else sculling_law(cfg.subsamples)).predict(
         math.radians(cfg.angle_amplitude_deg), cfg.accel_amplitude, math.radians(cfg.phase_deg),
         2 * math.pi * cfg.frequency_hz, h)
     predicted = np.array([0.0, 0.0, law])
