@@ -25,7 +25,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         "and error against exact truth. Human-readable by default, --json for machines. "
         "--motion sculling is classical sculling (θ0 sin Ωt about body x, A sin(Ωt + ψ) m/s² "
         "along body y, no gravity) through the velocity algorithm (rotvec, --subsamples N = "
-        "1-6, --structure conventional or single-chain); it reports the rectified velocity-"
+        "1-6, --structure conventional or single-chain; or the rate-input duals --algorithm "
+        "rate-single|rate-three, float64); it reports the rectified velocity-"
         "error rate (velocity_error_rate_m_s2, navigation frame) and the sculling law's "
         "(predicted_velocity_error_rate_m_s2).")
     p.set_defaults(handler=run)
