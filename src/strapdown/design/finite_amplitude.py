@@ -38,6 +38,8 @@ directions, and the ``a⁶ x⁶, x⁸, …`` coefficients, quadratic in them, ar
 method (an algebraic root, rounded to rationals). Conventional N = 6 at ``a = 1°``: 1.23–1.26×
 the ``a²`` law over Ωh 0.05–0.2 (the linear set: 2.79× at 0.2, and the ``a⁶`` term below);
 N = 5: 0.98–1.00× over 0.005–0.2. For the single chain no real root is found with these terms.
+The shipped conventional N = 4, 5, 6 ``finite-amplitude`` sets are these designs (N = 5
+with ``through_law``; :data:`strapdown.algorithms.finite_amplitude.A6_DESIGN`).
 
 Spin plus coning (``spin_ratio`` σ = ω_s/Ω, :func:`derive_spin_robust`): with body spin the
 axial increment is ``O(1)``, the ``a²`` drift of Table 3 drops to ``(Ωh)⁴`` (e.g.
