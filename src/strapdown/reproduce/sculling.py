@@ -385,7 +385,7 @@ def _dynamic_study(r: Report) -> dict[str, Any]:
           "for sculling, not for turns), and for conventional N ≥ 3 the Table 3 coning "
           "sets, optimised for coning, are not exact for a linearly varying rate either: "
           "their attitude error is third order (ratio 8), while N = 2's (2/3, exact for a "
-          "linear rate) sits at the float64 floor near 7e-11 rad. Velocity order "
+          "linear rate) falls by 20, fourth order or better. Velocity order "
           f"= log2(ratio); within 0.5 of the expected order: {len(met)} of {len(ratios)}.\n\n")
     r.add(r.table("flight", _FLIGHT_HEADER, rows))
     cosine = EarthFlight(FLIGHT, lat_deg=45.0, lon_deg=10.0, height=1000.0, speed=100.0,

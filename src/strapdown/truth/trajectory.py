@@ -274,20 +274,26 @@ class EarthState:
     q: np.ndarray
 
 
-def _smoothstep(k: int) -> np.polynomial.Polynomial:
-    """The polynomial ``S`` of degree 2k + 1 rising from 0 to 1 on [0, 1] with its first k
-    derivatives zero at both ends: ``S(x) = x^(k+1) Σ_n C(k+n, n) C(2k+1, k−n) (−x)^n``."""
-    c = np.zeros(2 * k + 2)
-    for n in range(k + 1):
-        c[k + 1 + n] = math.comb(k + n, n) * math.comb(2 * k + 1, k - n) * (-1) ** n
-    return np.polynomial.Polynomial(c)
-
-
-#: C-infinity is not needed: the smooth ramp's first RAMP_SMOOTHNESS derivatives vanish at
-#: its ends, enough for the orders the navigation algorithms reach (see EarthFlight).
+#: The smooth ramp's first RAMP_SMOOTHNESS derivatives vanish at its ends: enough for the
+#: orders the navigation algorithms reach (C-infinity is not needed).
 RAMP_SMOOTHNESS = 8
-_S = _smoothstep(RAMP_SMOOTHNESS)
-_S1, _S2, _SI = _S.deriv(), _S.deriv(2), _S.integ()
+
+
+def _smoothstep(x, k: int = RAMP_SMOOTHNESS):
+    """``S, S', S''`` and ``∫_0^x S`` of the smoothstep of degree 2k + 1 on [0, 1]:
+    ``S' = c (x(1 − x))^k``, ``c = (2k+1)!/(k!)²``, so that S rises from 0 to 1 with its
+    first k derivatives zero at both ends. Evaluated in ``y = 2x − 1``, where
+    ``x(1 − x) = (1 − y²)/4`` and the sums are short and well conditioned (the power basis
+    in x loses ~1e-10 to cancellation)."""
+    c = math.factorial(2 * k + 1) / math.factorial(k) ** 2 / 4.0**k
+    y = 2.0 * x - 1.0
+    u = 1.0 - y * y
+    s = 0.5 + 0.5 * c * sum(math.comb(k, j) * (-1) ** j * y ** (2 * j + 1) / (2 * j + 1)
+                            for j in range(k + 1))
+    integral = 0.5 * x + 0.25 * c * sum(
+        math.comb(k, j) * (-1) ** j * (y ** (2 * j + 2) - 1.0) / ((2 * j + 1) * (2 * j + 2))
+        for j in range(k + 1))
+    return s, c * u**k, -4.0 * c * k * y * u ** (k - 1), integral
 
 
 def _ramp(s, tau, a, b, shape="smooth"):
@@ -304,11 +310,11 @@ def _ramp(s, tau, a, b, shape="smooth"):
         ramp_int = a * np.minimum(s, tau) + (b - a) / 2 * (np.minimum(s, tau)
                                                            - tau / np.pi * np.sin(x))
     else:
-        x = np.minimum(s, tau) / tau
-        val = np.where(on, a + (b - a) * _S(x), b)
-        rate = np.where(on, (b - a) / tau * _S1(x), 0.0)
-        acc = np.where(on, (b - a) / tau**2 * _S2(x), 0.0)
-        ramp_int = a * np.minimum(s, tau) + (b - a) * tau * _SI(x)
+        sv, s1, s2, si = _smoothstep(np.minimum(s, tau) / tau)
+        val = np.where(on, a + (b - a) * sv, b)
+        rate = np.where(on, (b - a) / tau * s1, 0.0)
+        acc = np.where(on, (b - a) / tau**2 * s2, 0.0)
+        ramp_int = a * np.minimum(s, tau) + (b - a) * tau * si
     integral = ramp_int + b * np.maximum(s - tau, 0.0)
     return val, rate, acc, integral
 
