@@ -150,8 +150,8 @@ def fake_bench(monkeypatch):
 
     calls = []
 
-    def run_benchmarks(*args, log=None):
-        calls.append(args)
+    def run_benchmarks(*args, nav_samples, log=None):
+        calls.append((*args, nav_samples))
         if log is not None:
             log("[1/1] numpy-single-pass")
         return FAKE_RECORDS
@@ -162,14 +162,14 @@ def fake_bench(monkeypatch):
 
 def test_bench_is_an_ordinary_subcommand_with_every_option(fake_bench, capsys):
     assert main(["bench", "--samples", "100", "--peer-samples", "7", "--stream-samples", "0",
-                 "--ekf-samples", "0", "--repeat", "1", "--json"]) == 0
-    assert fake_bench == [(100, 7, 1, 0, 0)]  # samples, peer, repeat, stream, ekf
+                 "--ekf-samples", "0", "--nav-samples", "0", "--repeat", "1", "--json"]) == 0
+    assert fake_bench == [(100, 7, 1, 0, 0, 0)]  # samples, peer, repeat, stream, ekf, nav
     assert json.loads(capsys.readouterr().out) == FAKE_RECORDS
 
 
 def test_bench_defaults_and_table(fake_bench, capsys):
     assert main(["bench"]) == 0
-    assert fake_bench == [(10_000_000, 20_000, 3, 100_000_000, 1_000_000)]
+    assert fake_bench == [(10_000_000, 20_000, 3, 100_000_000, 1_000_000, 2_000_000)]
     lines = capsys.readouterr().out.splitlines()
     assert lines[0].split() == ["name", "samples/s", "×", "numpy", "pass", "peer"]
     assert lines[1].split() == ["numpy-single-pass", "2.000e+09", "1.0000"]
