@@ -50,3 +50,24 @@ def test_a_failed_metadata_write_keeps_the_earlier_pair(tmp_path, capsys, monkey
     monkeypatch.setattr(_logs.json, "dumps", full)
     assert _ahrs(tmp_path, capsys, out)[0] == 74
     assert {p.name: p.read_bytes() for p in out.parent.iterdir()} == before
+
+
+def test_a_failed_sidecar_rename_removes_the_new_attitude(tmp_path, capsys, monkeypatch):
+    """The attitude lands first; when the sidecar's own rename then fails, the attitude is
+    removed again so no OUT stands without its OUT.meta.json."""
+    import os
+
+    from strapdown.io import files
+
+    real = os.replace
+
+    def replace(src, dst):
+        if str(dst).endswith(".meta.json"):
+            raise OSError(errno.EIO, "Input/output error", str(dst))
+        return real(src, dst)
+
+    (tmp_path / "o").mkdir()
+    monkeypatch.setattr(files.os, "replace", replace)
+    code, err = _ahrs(tmp_path, capsys, tmp_path / "o" / "att.csv")
+    assert code == 74 and "Input/output error" in err and err.count("\n") == 1
+    assert list((tmp_path / "o").iterdir()) == []

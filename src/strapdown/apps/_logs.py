@@ -132,12 +132,20 @@ def output_with_sidecar(out: Path) -> Iterator[PairedOutput]:
     ``meta``; both land when the block ends without an exception, the sidecar last.
     """
     meta_path = sidecar_path(out)
-    with atomic_path(meta_path) as meta_tmp, atomic_path(out) as tmp:
-        paired = PairedOutput(Path(tmp))
-        yield paired
-        if not paired.meta:
-            raise RuntimeError("output_with_sidecar: no metadata was given")
-        meta_tmp.write_text(json.dumps(paired.meta, indent=2, ensure_ascii=False) + "\n",
-                            encoding="utf-8")
-        meta_path.unlink(missing_ok=True)  # a stale sidecar must not describe the new OUT
+    landed = False  # OUT renamed into place, its sidecar not yet
+    try:
+        with atomic_path(meta_path) as meta_tmp:
+            with atomic_path(out) as tmp:
+                paired = PairedOutput(Path(tmp))
+                yield paired
+                if not paired.meta:
+                    raise RuntimeError("output_with_sidecar: no metadata was given")
+                meta_tmp.write_text(json.dumps(paired.meta, indent=2, ensure_ascii=False)
+                                    + "\n", encoding="utf-8")
+                meta_path.unlink(missing_ok=True)  # no stale sidecar for the new OUT
+            landed = True
+    except BaseException:
+        if landed:  # the sidecar's rename failed: an OUT without its metadata is not left
+            out.unlink(missing_ok=True)
+        raise
     # atomic_path(out) renamed the attitude first, atomic_path(meta_path) the sidecar last
