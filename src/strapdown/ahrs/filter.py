@@ -417,9 +417,13 @@ def attitude_from_acc_mag(acc, mag=None, *, declination_deg: float = 0.0) -> np.
     rotated by the declination. Without ``mag`` the yaw is zero (x_b's
     horizontal projection points east).
     """
+    from strapdown._core.scaling import pow2_exponent
+
     f = np.asarray(acc, float)
-    if f.shape != (3,) or not np.all(np.isfinite(f)) or np.linalg.norm(f) == 0:
+    if f.shape != (3,) or not np.all(np.isfinite(f)) or not np.any(f):
         raise ValueError(f"acc must be a finite non-zero (3,) vector, got {f!r}")
+    # only directions are used: scaling by 2^-e (exact) keeps norms in range for any input
+    f = np.ldexp(f, -pow2_exponent(f))
     up = f / np.linalg.norm(f)
     if mag is None:
         ref = np.array([1.0, 0.0, 0.0]) if abs(up[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
@@ -430,6 +434,7 @@ def attitude_from_acc_mag(acc, mag=None, *, declination_deg: float = 0.0) -> np.
         m = np.asarray(mag, float)
         if m.shape != (3,) or not np.all(np.isfinite(m)):
             raise ValueError(f"mag must be a finite (3,) vector, got {m!r}")
+        m = np.ldexp(m, -pow2_exponent(m))
         mh = m - up * (m @ up)
         if np.linalg.norm(mh) < 1e-6 * max(float(np.linalg.norm(m)), 1e-300):
             raise ValueError("the magnetic field is vertical: heading is undefined")
