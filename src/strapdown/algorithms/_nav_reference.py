@@ -168,12 +168,12 @@ def earth_nav(body, period, pos0, v0, q0, m: Backend):
         t4 = cross(zeta, t1)
         dx = tuple(x[c] - h3[0][9 + c] if len(hist) > 1 else 0 * period for c in range(3))
         t5 = cross(zeta, dx)
-        vn = [v[c] + (x[c] - 0.5 * t1[c] - t3[c] / 12 + t4[c] / 6 - t5[c] / 12)
+        vp = [v[c] + (x[c] - 0.5 * t1[c] - t3[c] / 12 + t4[c] / 6 - t5[c] / 12)
               + period * _am(k, pred[3 + c], *col[3 + c]) for c in range(3)]
         pp = [p[c] + period * _am(k, pred[6 + c], *col[6 + c]) for c in range(3)]
-        end = earth_rates(pp[0], pp[2], vn, m)
+        end = earth_rates(pp[0], pp[2], vp, m)
         w = 0.5 if k == 2 else (5 / 12 if k == 3 else 0.375)
-        vn = tuple(vn[c] + period * w * (end[3 + c] - pred[3 + c]) for c in range(3))
+        vn = tuple(vp[c] + period * w * (end[3 + c] - pred[3 + c]) for c in range(3))
         ps.append(tuple(p[c] + period * _am(k, end[6 + c], *col[6 + c]) for c in range(3)))
         vs.append(vn)
         hist = [tuple(end) + tuple(x), *hist[:2]]
