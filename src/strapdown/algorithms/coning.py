@@ -186,7 +186,8 @@ def _none(n):
 def _finite_amplitude(n):
     base = _table3(n)
     return CoefficientSet("finite-amplitude", n, base.matrix, base.exact,
-                          "Table 3 + triple cross products (strapdown designer, a⁴ cancelled)",
+                          "Table 3 + triple cross products (strapdown designer: a⁴ cancelled, "
+                          "and a⁶ for N = 4-6)",
                           True, triple_terms("conventional", n))
 
 

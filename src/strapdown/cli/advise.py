@@ -8,10 +8,6 @@ from strapdown.cli._common import columns, json_arg, log_args, print_json, say
 
 __all__ = ["add_parser", "run"]
 
-#: Operations of one triple term θ_L × (θ_(L−m) × θ_L) added to φ: a cross product
-#: (6 mul, 3 add) and a scaled cross-add (9 mul, 6 add), as export-c counts its terms.
-_TRIPLE_OPS = 24
-
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
     """Register ``advise`` (its options are added when it is used)."""
@@ -60,17 +56,13 @@ def _arguments(p: argparse.ArgumentParser) -> None:
 
 def _ops_per_s(spec, h: float) -> float:
     """Operations per second of ``spec`` at samples every ``h``: the C exporter's counts per
-    update (every arithmetic operation and libm call) times the updates per second."""
-    from dataclasses import replace
-
+    update (every arithmetic operation and libm call, triple terms included) times the
+    updates per second."""
     from strapdown.codegen.export_c import generate
 
-    triple = spec.resolved_coefficients == "finite-amplitude"
-    base = replace(spec, coefficients=None) if triple else spec
-    exp = generate(base.algorithm, structure=base.structure, subsamples=base.subsamples,
-                   coefficients=base.coefficients, h=h)
-    ops = sum(exp.ops.values()) + (_TRIPLE_OPS * (spec.subsamples - 1) if triple else 0)
-    return ops / spec.update_period(h)
+    exp = generate(spec.algorithm, structure=spec.structure, subsamples=spec.subsamples,
+                   coefficients=spec.coefficients, h=h)
+    return sum(exp.ops.values()) / spec.update_period(h)
 
 
 def _spectrum(args: argparse.Namespace):
