@@ -30,3 +30,19 @@ def test_flight_velocity_and_position_are_consistent():
     assert np.allclose(dlat[2:-2], (s.velocity[:, 0] / rn)[2:-2], rtol=1e-4)
     # the climb leg reaches 5° flight-path angle: v_D = −V sin 5°
     assert np.isclose(s.velocity[-1, 2], -100.0 * np.sin(np.radians(5.0)), rtol=1e-12)
+
+
+def test_equal_flights_share_one_integration_and_others_do_not():
+    from strapdown.truth.trajectory import EarthFlight, EarthSegment
+
+    legs = [EarthSegment(20.0), EarthSegment(20.0, 3.0)]
+    a = EarthFlight(legs, lat_deg=30.0, speed=50.0)
+    t = np.linspace(0.0, 40.0, 7)
+    pa = a.state(t)
+    b = EarthFlight(list(legs), lat_deg=30.0, speed=50.0)
+    b.state(t)
+    assert b._sol is a._sol  # taken from the cache, not integrated again
+    c = EarthFlight(legs, lat_deg=30.0, speed=50.0, height=10.0)
+    pc = c.state(t)
+    assert c._sol is not a._sol
+    assert np.array_equal(b.state(t).lat, pa.lat) and not np.array_equal(pc.height, pa.height)

@@ -319,6 +319,14 @@ def _ramp(s, tau, a, b, shape="smooth"):
     return val, rate, acc, integral
 
 
+#: Position integrations of flights already solved in this process, by their defining
+#: parameters (:meth:`EarthFlight._key`): a 10-minute flight at rtol 1e-13 takes about a
+#: minute to integrate, and tests and reports build equal flights many times. At most
+#: :data:`_EARTH_FLIGHT_CACHE` are kept.
+_EARTH_FLIGHT_SOLUTIONS: dict[tuple, tuple] = {}
+_EARTH_FLIGHT_CACHE = 8
+
+
 class EarthFlight:
     """A flight over the WGS-84 Earth: legs of constant speed with smooth turns and climbs.
 
@@ -406,7 +414,15 @@ class EarthFlight:
         dphi = k * ddpsi / (1.0 + (k * dpsi) ** 2)
         return (psi, gam, phi), (dpsi, dgam, dphi)
 
+    def _key(self) -> tuple:
+        """What the position integration depends on (a flight's defining parameters)."""
+        return (self.segments, self.lat0, self.lon0, self.h0, self.speed, self.heading0,
+                self.ramp, self.ramp_shape)
+
     def _solve(self):
+        if self._sol is None and self._key() in _EARTH_FLIGHT_SOLUTIONS:
+            # an equal flight was integrated in this process: its solution is immutable
+            self._knots, self._sol = _EARTH_FLIGHT_SOLUTIONS[self._key()]
         if self._sol is None:
             from scipy.integrate import solve_ivp
 
@@ -433,6 +449,9 @@ class EarthFlight:
                 y0 = sol.y[:, -1]
             self._knots = knots
             self._sol = sols
+            while len(_EARTH_FLIGHT_SOLUTIONS) >= _EARTH_FLIGHT_CACHE:  # oldest out
+                _EARTH_FLIGHT_SOLUTIONS.pop(next(iter(_EARTH_FLIGHT_SOLUTIONS)))
+            _EARTH_FLIGHT_SOLUTIONS[self._key()] = (knots, sols)
         return self._sol
 
     def _position(self, t):
