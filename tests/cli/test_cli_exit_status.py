@@ -8,27 +8,13 @@ import sys
 
 import pytest
 
+from cli_helpers import evaluate_raises, exit_of
 from strapdown.cli import EXIT_STATUS, main
 
 
-def _exit(capsys, *args) -> tuple[int, str]:
-    with pytest.raises(SystemExit) as exc:
-        main(list(args))
-    return exc.value.code, capsys.readouterr().err
-
-
-def _evaluate_raises(monkeypatch, error: BaseException) -> None:
-    from strapdown.analysis import evaluate
-
-    def boom(cfg):
-        raise error
-
-    monkeypatch.setattr(evaluate, "evaluate", boom)
-
-
 def test_ctrl_c_is_one_line_and_status_130(monkeypatch, capsys):
-    _evaluate_raises(monkeypatch, KeyboardInterrupt())
-    assert _exit(capsys, "evaluate", "--duration", "0.1") == (
+    evaluate_raises(monkeypatch, KeyboardInterrupt())
+    assert exit_of(capsys, "evaluate", "--duration", "0.1") == (
         130, "strapdown evaluate: interrupted\n")
 
 
@@ -39,7 +25,7 @@ def test_sweep_interruption_says_how_far_it_got(monkeypatch, capsys):
         raise sweep.SweepInterrupted(9, 30)
 
     monkeypatch.setattr(sweep, "sweep", interrupted)
-    assert _exit(capsys, "sweep", "scenario.toml", "--out", "o") == (
+    assert exit_of(capsys, "sweep", "scenario.toml", "--out", "o") == (
         130, "strapdown sweep: interrupted, 9/30 cases done; rerun the same command to resume\n")
 
 
@@ -50,15 +36,15 @@ def test_sweep_interruption_says_how_far_it_got(monkeypatch, capsys):
     (OSError("no path given"), "no path given"),
 ])
 def test_os_error_names_the_path_with_status_74(monkeypatch, capsys, error, line):
-    _evaluate_raises(monkeypatch, error)
-    assert _exit(capsys, "evaluate", "--duration", "0.1") == (
+    evaluate_raises(monkeypatch, error)
+    assert exit_of(capsys, "evaluate", "--duration", "0.1") == (
         74, f"strapdown evaluate: error: {line}\n")
 
 
 def test_unwritable_output_names_the_target_not_a_temp_file(tmp_path, capsys):
     blocker = tmp_path / "file"
     blocker.write_text("")  # a file where the output directory should be
-    code, err = _exit(capsys, "export-c", "--algorithm", "rotvec", "--structure",
+    code, err = exit_of(capsys, "export-c", "--algorithm", "rotvec", "--structure",
                       "single-chain", "--subsamples", "3", "--out", str(blocker / "flight"))
     assert code == 74 and err.startswith("strapdown export-c: error: ")
     assert str(blocker) in err and "/." not in err and "Traceback" not in err
@@ -74,8 +60,8 @@ def test_closed_stdout_is_quiet_with_status_141():
 
 
 def test_help_lists_every_exit_status(capsys):
-    assert _exit(capsys, "--help")[0] == 0
-    # (help goes to stdout; _exit read stderr, so read the help again)
+    assert exit_of(capsys, "--help")[0] == 0
+    # (help goes to stdout; exit_of read stderr, so read the help again)
     with pytest.raises(SystemExit):
         main(["--help"])
     text = capsys.readouterr().out
@@ -102,7 +88,7 @@ def _log(tmp_path):
 def test_output_path_errors_are_one_line_with_status_74(tmp_path, capsys, out, reason):
     (tmp_path / "outdir.csv").mkdir()
     (tmp_path / "afile").write_text("")
-    code, err = _exit(capsys, "run", "--imu", _log(tmp_path), "--rates", "--units", "rad/s",
+    code, err = exit_of(capsys, "run", "--imu", _log(tmp_path), "--rates", "--units", "rad/s",
                       "--out", str(tmp_path / out))
     assert code == 74 and err.strip().endswith(reason) and len(err.strip().splitlines()) == 1
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a.npy", "afile", "outdir.csv"]
@@ -117,7 +103,7 @@ def test_unwritable_output_directory_is_status_74(tmp_path, capsys, monkeypatch)
 
     log = _log(tmp_path)
     monkeypatch.setattr(tempfile, "mkstemp", refuse)  # as a read-only directory does
-    code, err = _exit(capsys, "run", "--imu", log, "--rates", "--units", "rad/s", "--out",
+    code, err = exit_of(capsys, "run", "--imu", log, "--rates", "--units", "rad/s", "--out",
                       str(tmp_path / "ro" / "x.csv"))
     assert code == 74 and err.strip().endswith("x.csv.meta.json: Permission denied")
 
@@ -134,13 +120,13 @@ def test_unreadable_input_is_status_74_naming_it(tmp_path, capsys, monkeypatch):
         return real_open(file, *args, **kwargs)
 
     monkeypatch.setattr(builtins, "open", guarded)
-    code, err = _exit(capsys, "run", "--imu", log, "--rates", "--units", "rad/s", "--out",
+    code, err = exit_of(capsys, "run", "--imu", log, "--rates", "--units", "rad/s", "--out",
                       str(tmp_path / "x.csv"))
     assert (code, err) == (74, f"strapdown run: error: {log}: Permission denied\n")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a.npy"]
 
 
 def test_an_input_directory_is_bad_input(tmp_path, capsys):
-    code, err = _exit(capsys, "run", "--imu", str(tmp_path), "--rates", "--units", "rad/s",
+    code, err = exit_of(capsys, "run", "--imu", str(tmp_path), "--rates", "--units", "rad/s",
                       "--out", str(tmp_path / "x.csv"))
     assert code == 2 and "is a directory; expected a log file" in err

@@ -15,6 +15,7 @@ from pathlib import Path
 
 import pytest
 
+from cli_helpers import evaluate_raises, exit_of
 from strapdown.cli import EXIT_INTERNAL, EXIT_STATUS, EXIT_TERMINATED, MAX_MESSAGE, main
 from strapdown.io.files import atomic_path, remove_stale_temps
 
@@ -22,25 +23,10 @@ EXPORT = ["export-c", "--algorithm", "rotvec", "--structure", "single-chain", "-
           "3"]
 
 
-def _exit(capsys, *args) -> tuple[int, str]:
-    with pytest.raises(SystemExit) as exc:
-        main(list(args))
-    return exc.value.code, capsys.readouterr().err
-
-
-def _evaluate_raises(monkeypatch, error: BaseException) -> None:
-    from strapdown.analysis import evaluate
-
-    def boom(cfg):
-        raise error
-
-    monkeypatch.setattr(evaluate, "evaluate", boom)
-
-
 def test_internal_error_is_one_bounded_line_with_status_70(monkeypatch, capsys):
     monkeypatch.delenv("STRAPDOWN_TRACEBACK", raising=False)
-    _evaluate_raises(monkeypatch, RuntimeError("boom\n" + "x" * 5000))
-    code, err = _exit(capsys, "evaluate", "--duration", "0.1")
+    evaluate_raises(monkeypatch, RuntimeError("boom\n" + "x" * 5000))
+    code, err = exit_of(capsys, "evaluate", "--duration", "0.1")
     assert code == EXIT_INTERNAL == 70 and code in EXIT_STATUS
     assert err.startswith("strapdown evaluate: internal error: RuntimeError: boom x")
     assert "please report it" in err and "with the command line" in err
@@ -49,7 +35,7 @@ def test_internal_error_is_one_bounded_line_with_status_70(monkeypatch, capsys):
 
 def test_strapdown_traceback_reraises_the_internal_error(monkeypatch):
     monkeypatch.setenv("STRAPDOWN_TRACEBACK", "1")
-    _evaluate_raises(monkeypatch, RuntimeError("boom"))
+    evaluate_raises(monkeypatch, RuntimeError("boom"))
     with pytest.raises(RuntimeError, match="boom"):
         main(["evaluate", "--duration", "0.1"])
 
@@ -57,8 +43,8 @@ def test_strapdown_traceback_reraises_the_internal_error(monkeypatch):
 def test_input_error_is_still_status_2(monkeypatch, capsys):
     from strapdown import InputError
 
-    _evaluate_raises(monkeypatch, InputError("scenario.toml: bad"))
-    assert _exit(capsys, "evaluate", "--duration", "0.1") == (
+    evaluate_raises(monkeypatch, InputError("scenario.toml: bad"))
+    assert exit_of(capsys, "evaluate", "--duration", "0.1") == (
         2, "strapdown evaluate: error: scenario.toml: bad\n")
 
 
