@@ -117,6 +117,9 @@ def main(argv: list[str] | None = None) -> int:
     owner = os.getpid()
 
     def on_sigterm(signum, frame) -> None:
+        # one SIGTERM is enough: a second one (a pool's terminate() after the process
+        # group's signal) must not interrupt the cleanup the first one started
+        signal.signal(signal.SIGTERM, signal.SIG_IGN)
         if os.getpid() != owner:  # a forked pool worker (a sweep's): exit, quietly, releasing
             raise SystemExit(EXIT_TERMINATED)  # its locks (the pool's queues) on the way out
         got.append(signum)
