@@ -333,13 +333,17 @@ class Tally:
     cli_ok: int = 0
     cli_refused: int = 0
 
+    def measure(self, inp: Input, rec: dict) -> None:
+        """Take a run's time and peak memory (a valid input's also as the baseline)."""
+        self.slowest = max(self.slowest, rec["seconds"])
+        self.peak_mb = max(self.peak_mb, rec["peak_mb"])
+        if inp.origin.endswith("_valid"):
+            self.valid_peak_mb = max(self.valid_peak_mb, rec["peak_mb"])
+
 
 def _judge(t: Tally, inp: Input, rec: dict) -> None:
     t.runs += 1
-    t.slowest = max(t.slowest, rec["seconds"])
-    t.peak_mb = max(t.peak_mb, rec["peak_mb"])
-    if inp.origin.endswith("_valid"):
-        t.valid_peak_mb = max(t.valid_peak_mb, rec["peak_mb"])
+    t.measure(inp, rec)
     where = f"{inp.origin} [{rec['target']}]"
     if rec["outcome"] == "ok":
         t.ok += 1
@@ -417,10 +421,7 @@ def _cli(items: list[Input], per_format: int, tallies: dict[str, Tally], scratch
             rec = run_cli(args, inp.path, d)
             shutil.rmtree(d, ignore_errors=True)
             t.cli_runs += 1
-            t.slowest = max(t.slowest, rec["seconds"])
-            t.peak_mb = max(t.peak_mb, rec["peak_mb"])
-            if inp.origin.endswith("_valid"):
-                t.valid_peak_mb = max(t.valid_peak_mb, rec["peak_mb"])
+            t.measure(inp, rec)
             where = f"{inp.origin} [strapdown {rec['command']}]"
             if not rec["ok"]:
                 t.failures.append(f"{where}: exit {rec['code']} signal {rec['signal']}: "
