@@ -32,3 +32,21 @@ def test_other_errors_pass_unchanged(tmp_path):
     with pytest.raises(OSError) as exc, atomic_path(tmp_path / "a.csv"):
         raise FileNotFoundError(2, "No such file or directory", "input.csv")
     assert exc.value.filename == "input.csv"
+
+
+def test_ctrl_c_as_the_temporary_file_is_created_leaves_nothing(tmp_path, monkeypatch):
+    """A Ctrl-C arriving just after the temporary file exists, before its name is known to
+    the clean-up, is held back until it is (a signalled sweep once left such a file)."""
+    import signal
+
+    made = tempfile.mkstemp
+
+    def then_interrupted(**kw):
+        fd, name = made(**kw)
+        os.kill(os.getpid(), signal.SIGINT)  # Python's handler raises KeyboardInterrupt
+        return fd, name
+
+    monkeypatch.setattr(tempfile, "mkstemp", then_interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        write_text(tmp_path / "case.json", "{}")
+    assert list(tmp_path.iterdir()) == []
