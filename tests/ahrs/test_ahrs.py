@@ -139,27 +139,63 @@ def test_bias_is_estimated_at_rest_and_then_in_motion():
     assert err[t[r.index] > 1].max() < math.radians(0.5)
 
 
-def test_magnetic_anomaly_is_rejected_and_heading_recovers():
+def _anomalous_field(t, q, stop):
+    """A body-fixed 19 µT anomaly from 20 s to ``stop`` (a magnet carried along: at some
+    orientations the field's norm and dip look undisturbed, only the gate sees it)."""
     from strapdown.truth import sensors
 
+    errs = sensors.MagnetometerErrors(white_noise=0.2, anomaly=[15.0, -10.0, 5.0],
+                                      anomaly_start=20.0, anomaly_stop=stop)
+    return sensors.magnetometer(t, q, M_N, errors=errs, rng=3)
+
+
+def test_magnetic_anomaly_is_rejected_and_heading_recovers():
+    """Rejected while it lasts less than ``recover_mag_s`` (here 15 s of the default 20 s:
+    after that a field that contradicts the gyro is taken as the truth, see
+    test_heading_recovery_after_recover_mag_s)."""
+    assert POINT.recover_mag_s == 20.0
     h = 1 / 100
     t = np.arange(int(80 / h)) * h
-    m = _motion()
-    q, w, acc, _ = _imu(m, t)
-    errs = sensors.MagnetometerErrors(white_noise=0.2, anomaly=[15.0, -10.0, 5.0],
-                                      anomaly_start=20.0, anomaly_stop=40.0)
-    mag = sensors.magnetometer(t, q, M_N, errors=errs, rng=3)
+    q, w, acc, _ = _imu(_motion(), t)
+    mag = _anomalous_field(t, q, stop=35.0)
     gated = ekf(t, w, acc, mag, q0=q[0], mag_reference=M_N, config=POINT)
     open_ = ekf(t, w, acc, mag, q0=q[0], mag_reference=M_N,
                 config=AhrsConfig(gating=False, gyro_sample="point"))
-    during = (t[gated.index] > 20) & (t[gated.index] < 40)
+    during = (t[gated.index] > 20) & (t[gated.index] < 35)
     e_g = attitude_error_angle(gated.q, q[gated.index])
     e_o = attitude_error_angle(open_.q, q[open_.index])
     assert np.mean((gated.flags[during] & Flag.MAG_USED) > 0) < 0.05  # rejected
     assert e_g[during].max() < 0.2 * e_o[during].max()
-    after = t[gated.index] > 45
+    assert not np.any(gated.flags & Flag.MAG_RECOVERED)
+    after = t[gated.index] > 40
     assert np.mean((gated.flags[after] & Flag.MAG_USED) > 0) > 0.95  # used again
     assert e_g[after].max() < math.radians(1.0)
+
+
+def test_heading_recovery_after_recover_mag_s():
+    """A wrong heading (30° in q0) that the gate keeps rejecting a clean field against is
+    recovered after ``recover_mag_s`` of rejections, not before; an anomaly that looks
+    clean and lasts longer than that is, by the same rule, taken as the truth."""
+    from strapdown.truth import sensors
+
+    h = 1 / 100
+    t = np.arange(int(60 / h)) * h
+    q, w, acc, _ = _imu(_motion(), t)
+    clean = sensors.magnetometer(t, q, M_N, errors=sensors.MagnetometerErrors(white_noise=0.2),
+                                 rng=3)
+    yaw = np.array([math.cos(math.radians(15)), 0.0, 0.0, math.sin(math.radians(15))])
+    for recover in (10.0, 20.0):
+        r = ekf(t, w, acc, clean, q0=quat_multiply(yaw, q[0]), mag_reference=M_N,
+                config=AhrsConfig(gyro_sample="point", recover_mag_s=recover))
+        e = np.degrees(attitude_error_angle(r.q, q[r.index]))
+        first = t[np.flatnonzero(r.flags & Flag.MAG_RECOVERED)[0]]
+        assert recover <= first < recover + 0.1
+        assert e[t < first].min() > 29.0  # the gate held the wrong heading until then
+        assert e[t > first + 5].max() < 0.5
+    long = _anomalous_field(t, q, stop=50.0)
+    r = ekf(t, w, acc, long, q0=q[0], mag_reference=M_N, config=POINT)
+    first = t[np.flatnonzero(r.flags & Flag.MAG_RECOVERED)[0]]
+    assert 40.0 <= first < 40.1
 
 
 def test_offline_combines_a_backward_pass_and_beats_the_causal_filter():
@@ -185,6 +221,35 @@ def test_offline_combines_a_backward_pass_and_beats_the_causal_filter():
     assert not fwd.smoothed
     e_f, e_o = (np.sqrt(np.mean(attitude_error_angle(r.q, q) ** 2)) for r in (fwd, off))
     assert e_o < 0.8 * e_f
+
+
+def test_the_backward_pass_has_its_own_rejection_budget():
+    """``offline_mag_reject_s`` is the backward pass's budget: the causal filter ignores
+    it. A mild body-fixed disturbance (9 µT, mostly vertical: flagged by the norm check
+    almost throughout, within the heading gate) lasting 15 s, longer than a 2 s budget: the
+    unlimited default keeps it out of the backward pass, which then bridges it on the gyro,
+    and the smoothed error is smaller than with the backward budget as short as the
+    forward one."""
+    from strapdown.ahrs import offline_ekf
+    from strapdown.truth import sensors
+
+    h = 1 / 100
+    t = np.arange(int(60 / h)) * h
+    q, w, acc, _ = _imu(_motion(), t)
+    errs = sensors.MagnetometerErrors(white_noise=0.2, anomaly=[2.0, -1.5, 9.0],
+                                      anomaly_start=20.0, anomaly_stop=35.0)
+    mag = sensors.magnetometer(t, q, M_N, errors=errs, rng=3)
+    short = AhrsConfig(gyro_sample="point", mag_reject_s=2.0, offline_mag_reject_s=2.0)
+    unlimited = AhrsConfig(gyro_sample="point", mag_reject_s=2.0)
+    a, b = (ekf(t, w, acc, mag, q0=q[0], mag_reference=M_N, config=c) for c in (short, unlimited))
+    assert np.array_equal(a.q, b.q)
+    during = (t > 20) & (t < 35)
+    assert np.mean((b.flags[during] & Flag.MAG_DISTURBED) > 0) > 0.95  # after the low-pass
+    assert np.mean((b.flags[during] & Flag.MAG_USED) > 0) > 0.5  # after the forward budget
+    e_short, e_unl = (attitude_error_angle(offline_ekf(t, w, acc, mag, q0=q[0],
+                                                       mag_reference=M_N, config=c).q, q).max()
+                      for c in (short, unlimited))
+    assert e_unl < 0.95 * e_short
 
 
 @pytest.mark.parametrize("lag", [0, 3])
@@ -255,8 +320,11 @@ def test_a_coordinated_turn_does_not_tilt_the_low_pass_model():
     unchecked = ekf(t, w, acc, mag, q0=q[0], mag_reference=M_N,
                     config=AhrsConfig(**gate_off, acc_lowpass_norm_tol=1.0))
     assert checked.fraction(Flag.ACC_DISTURBED) > 0.6  # the turn
-    assert attitude_error_angle(checked.q, q).max() < math.radians(4.0)  # from the roll-in
-    assert attitude_error_angle(unchecked.q, q).max() > math.radians(10.0)
+    # the accelerometer is used only while the bank is below arccos(1/(1 + tol)) (9.9°),
+    # so what leaks in while rolling in cannot tilt the estimate further than that
+    e_checked, e_unchecked = (attitude_error_angle(r.q, q).max() for r in (checked, unchecked))
+    assert e_checked < math.acos(1.0 / (1.0 + checked.config.acc_lowpass_norm_tol))
+    assert e_unchecked > math.radians(30.0) and e_checked < 0.1 * e_unchecked
 
 
 def test_no_magnetometer_degraded_mode():
@@ -312,6 +380,11 @@ def test_bad_input_names_the_problem():
         ekf(t, w, acc, mag, algorithm="rotvek")
     with pytest.raises(ValueError, match=r"AhrsConfig\.acc_noise must be positive"):
         AhrsConfig(acc_noise=0.0)
+    assert AhrsConfig(mag_reject_s=math.inf).mag_reject_s == math.inf  # reject while it lasts
+    for bad in ({"mag_reject_s": -math.inf}, {"offline_mag_reject_s": math.nan},
+                {"heading_noise": math.inf}):
+        with pytest.raises(ValueError, match=rf"AhrsConfig\.{next(iter(bad))} must be"):
+            AhrsConfig(**bad)
     with pytest.raises(ValueError, match="frame must be 'ENU' or 'NED'"):
         ekf(t, w, acc, mag, frame="NWU")
 
@@ -347,15 +420,28 @@ def test_broad_metric_on_known_errors():
 
 @pytest.mark.skipif(BROAD is None, reason="BROAD data not found (set STRAPDOWN_BROAD)")
 def test_broad_acceptance_against_fusion_and_vqf(tmp_path):
-    """Mean total RMSE no worse than Fusion's; gating helps on the magnet trial."""
+    """Mean total RMSE no worse than Fusion's; gating helps on the magnet trial. On the
+    fifteen shared trials, the issue's bars for the defaults (fitted figures; the
+    held-out ones come from benchmarks/ahrs_cv.py): causal mean total ≤ VQF's and
+    inclination ≤ 1.2 × VQF's, offline mean total ≤ offlineVQF's, and no trial beyond
+    2 × the VQF variant of its kind."""
     pytest.importorskip("imufusion")
     pytest.importorskip("vqf")
-    from strapdown.apps.ahrs_benchmark import benchmark, mean_total
+    from strapdown.apps.ahrs_benchmark import benchmark, mean_of, mean_total
 
     res = benchmark(BROAD, tmp_path / "bench")
     ours, fusion, vqf = (mean_total(res, f) for f in ("strapdown EKF", "Fusion", "VQF"))
     assert ours <= fusion
     assert vqf < fusion  # the peers ran and are sane
+    if len(list(BROAD.glob("*.mat"))) == 15:  # the bars are about the shared set
+        assert ours <= vqf
+        assert (mean_of(res, "strapdown EKF", "inclination_deg")
+                <= 1.2 * mean_of(res, "VQF", "inclination_deg"))
+        assert mean_total(res, "strapdown EKF offline") <= mean_total(res, "offlineVQF")
+        for (trial, f), e in res.items():
+            ref = {"strapdown EKF": "VQF", "strapdown EKF offline": "offlineVQF"}.get(f)
+            if ref:
+                assert e["total_deg"] <= 2.0 * res[(trial, ref)]["total_deg"], (trial, f)
     magnet = "33_disturbed_attached_magnet_2cm"
     assert (res[(magnet, "strapdown EKF")]["total_deg"]
             < 0.9 * res[(magnet, "strapdown EKF, no gating")]["total_deg"])
@@ -381,8 +467,10 @@ def test_cli_ahrs_csv_roundtrip_and_degraded_mode(tmp_path, capsys):
     a = np.genfromtxt(out, delimiter=",", names=True)
     assert a.dtype.names == ("t", "qw", "qx", "qy", "qz", "bias_x", "bias_y", "bias_z")
     assert a.size == t.size and a["t"][0] == t[0]  # one row per sample, the first at t[0]
-    meta = json.loads((tmp_path / "att.csv.meta.json").read_text())
+    text = (tmp_path / "att.csv.meta.json").read_text()
+    meta = json.loads(text, parse_constant=lambda c: pytest.fail(f"not JSON: {c}"))
     assert meta["frame"] == "ENU" and meta["heading_observed"] is True
+    assert meta["config"]["offline_mag_reject_s"] == "inf"  # JSON has no infinity
     assert meta["mode"].startswith("causal")
     assert main(["ahrs", "--imu", str(tmp_path / "imu.csv"), "--gyro-units", "deg/s",
                  "--acc-units", "g", "--offline", "--gyro-sample", "point", "--out",
