@@ -8,7 +8,12 @@ so); total error ``2 acos|δq_w|``, heading error ``2 atan|δq_z / δq_w|`` (the
 rotation about the vertical; taken as ``2 atan2(|δq_z|, |δq_w|)``, the same
 value, defined also where both vanish), inclination error ``2 acos √(δq_w² + δq_z²)``
 (the rest); each an RMSE in degrees over the movement phases, one estimate per
-sample, samples whose reference is NaN (markers lost) skipped.
+sample, samples whose reference is NaN (markers lost) skipped. The arc cosines are
+evaluated as the equal arc tangents ``2 atan2(‖δq_xyz‖, |δq_w|)`` and
+``2 atan2(√(δq_x² + δq_y²), √(δq_w² + δq_z²))``: near zero error ``acos`` turns a
+rounding error of 1e-16 in its argument into 1.5e-8 rad (a pure heading error then
+showed an inclination of 1e-6° or none, depending on the quaternions' signs); the
+arc tangents are exact to rounding there and equal elsewhere.
 
 Removing the constant heading offset between the two frames (the circular mean
 of the heading error) is *not* BROAD's metric; :func:`broad_errors` computes it
@@ -30,11 +35,11 @@ __all__ = ["broad_errors"]
 
 def _angles(dq: NDArray[np.float64]) -> tuple[NDArray[np.float64], ...]:
     """BROAD's total, heading and inclination angles (rad) of error quaternions δq."""
-    w = dq[:, 0]
-    total = 2.0 * np.arccos(np.clip(np.abs(w), 0.0, 1.0))
+    w, x, y, z = np.abs(dq).T
+    total = 2.0 * np.arctan2(np.sqrt(x**2 + y**2 + z**2), w)  # = 2 acos|w|
     # = 2 atan|z/w| wherever that is defined; 0 where w = z = 0 (no twist to take)
-    heading = 2.0 * np.arctan2(np.abs(dq[:, 3]), np.abs(w))
-    incl = 2.0 * np.arccos(np.clip(np.sqrt(w**2 + dq[:, 3] ** 2), 0.0, 1.0))
+    heading = 2.0 * np.arctan2(z, w)
+    incl = 2.0 * np.arctan2(np.hypot(x, y), np.hypot(w, z))  # = 2 acos √(w² + z²)
     return total, heading, incl
 
 
