@@ -13,6 +13,7 @@ from pathlib import Path
 
 import pytest
 
+from cli_helpers import default_sigint
 from strapdown._core.compile_notice import MESSAGE
 from strapdown.apps.sweep import cases, load_scenario, sweep
 
@@ -95,7 +96,8 @@ def test_killed_sweep_process_resumes(tmp_path):
     try:
         deadline = time.monotonic() + 120
         while time.monotonic() < deadline and proc.poll() is None:
-            if len(list((out / "cases").glob("*.json"))) >= 3:
+            # finished cases only: pathlib's glob also matches the hidden temporary files
+            if sum(not f.name.startswith(".") for f in (out / "cases").glob("*.json")) >= 3:
                 break
             time.sleep(0.01)
         os.killpg(proc.pid, signal.SIGKILL)
@@ -154,7 +156,7 @@ def test_ctrl_c_stops_sweep_with_one_line_and_status_130(tmp_path, workers):
     cmd = [sys.executable, "-m", "strapdown.cli", "sweep", str(scn), "--out", str(out),
            "--workers", workers, "--no-progress"]
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            start_new_session=True)
+                            start_new_session=True, preexec_fn=default_sigint)
     deadline = time.monotonic() + 120
     while time.monotonic() < deadline and proc.poll() is None:
         if len(list((out / "cases").glob("[!.]*.json"))) >= 2:

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import pytest
 
-from cli_helpers import evaluate_raises, exit_of
+from cli_helpers import default_sigint, evaluate_raises, exit_of
 from strapdown.cli import EXIT_INTERNAL, EXIT_STATUS, EXIT_TERMINATED, MAX_MESSAGE, main
 from strapdown.io.files import atomic_path, remove_stale_temps
 
@@ -69,7 +69,8 @@ _HELD = textwrap.dedent("""
 
 def _held(out: Path) -> tuple[subprocess.Popen, Path]:
     proc = subprocess.Popen([sys.executable, "-c", _HELD, *EXPORT, "--out", str(out)],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=default_sigint)
     tmp = Path(proc.stdout.readline().strip())
     assert tmp.is_file() and tmp.parent == out, proc.stderr.read()
     return proc, tmp
@@ -131,7 +132,7 @@ def test_ctrl_c_while_the_kernels_compile_is_one_line(tmp_path):
     proc = subprocess.Popen([sys.executable, "-m", "strapdown.cli", "run", "--imu", str(imu),
                              "--rates", "--units", "rad/s", "--out", str(tmp_path / "o.csv")],
                             stderr=subprocess.PIPE, stdout=subprocess.DEVNULL, text=True,
-                            env=env)
+                            env=env, preexec_fn=default_sigint)
     assert "compiling the numba kernels" in proc.stderr.readline()
     proc.send_signal(signal.SIGINT)
     err = proc.stderr.read()
@@ -165,7 +166,7 @@ def test_a_signal_to_a_pooled_sweeps_process_group_is_one_line(tmp_path, sig):
     proc = subprocess.Popen([sys.executable, "-m", "strapdown.cli", "sweep", str(scn), "--out",
                              str(tmp_path / "sw"), "--workers", "2", "--format", "csv"],
                             stderr=subprocess.PIPE, stdout=subprocess.DEVNULL, text=True,
-                            start_new_session=True)
+                            start_new_session=True, preexec_fn=default_sigint)
     assert "64 cases" in proc.stderr.readline()
     done = tmp_path / "sw" / "cases"
     for _ in range(1200):  # until the pool has finished a case

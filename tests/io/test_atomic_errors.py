@@ -47,6 +47,12 @@ def test_ctrl_c_as_the_temporary_file_is_created_leaves_nothing(tmp_path, monkey
         return fd, name
 
     monkeypatch.setattr(tempfile, "mkstemp", then_interrupted)
-    with pytest.raises(KeyboardInterrupt):
-        write_text(tmp_path / "case.json", "{}")
+    # Python's own handler, also when the suite was started with SIGINT ignored (a
+    # background job): restored by signal.signal at the end
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            write_text(tmp_path / "case.json", "{}")
+    finally:
+        signal.signal(signal.SIGINT, previous)
     assert list(tmp_path.iterdir()) == []
