@@ -18,12 +18,12 @@ cache says so on stderr first (:mod:`strapdown._core.compile_notice`).
 from __future__ import annotations
 
 import argparse
-import contextlib
 import os
 import signal
 import sys
 import textwrap
 
+from strapdown._core.signals import replaced_handlers
 from strapdown.cli import (
     advise,
     ahrs,
@@ -173,24 +173,10 @@ def _main(argv: list[str] | None, got: list[int]) -> int:
 def _exit(status: int, message: str | None = None) -> None:
     """Print ``message`` on stderr and raise ``SystemExit(status)`` (argparse's ``exit``)."""
     if message:
-        with _ignored_signals():
+        with replaced_handlers(signal.SIG_IGN):  # a second Ctrl-C adds nothing
             sys.stderr.write(message)
             sys.stderr.flush()
     raise SystemExit(status)
-
-
-@contextlib.contextmanager
-def _ignored_signals():
-    """SIGINT/SIGTERM ignored while the last line is printed (a second Ctrl-C adds nothing)."""
-    try:
-        saved = {s: signal.signal(s, signal.SIG_IGN) for s in (signal.SIGINT, signal.SIGTERM)}
-    except ValueError:  # not the main thread
-        saved = {}
-    try:
-        yield
-    finally:
-        for s, h in saved.items():
-            signal.signal(s, h)
 
 
 def _terminated(text: str) -> str:

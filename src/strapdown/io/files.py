@@ -14,8 +14,9 @@ import os
 import re
 import signal
 import tempfile
-import threading
 from pathlib import Path
+
+from strapdown._core.signals import replaced_handlers
 
 
 def _umask() -> int:
@@ -53,22 +54,21 @@ def atomic_path(path: str | os.PathLike):
     # the temporary file exists and its name is bound inside the block that removes it:
     # one arriving in between would leave it behind (seen once in a signalled sweep).
     held: list[int] = []
-    saved = _hold_signals(held)
     tmp: str | None = None
     try:
-        try:
-            fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.{os.getpid()}.",
-                                       suffix=path.suffix, dir=path.parent)
-        except OSError as exc:
-            raise OSError(exc.errno, exc.strerror, str(path)) from None
-        os.close(fd)
-        _release_signals(saved, held)  # a held signal is raised here, inside the clean-up
-        saved = {}
+        with replaced_handlers(lambda signum, frame: held.append(signum)):
+            try:
+                fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.{os.getpid()}.",
+                                           suffix=path.suffix, dir=path.parent)
+            except OSError as exc:
+                raise OSError(exc.errno, exc.strerror, str(path)) from None
+            os.close(fd)
+        for s in dict.fromkeys(held):  # its handler runs before raise_signal returns
+            signal.raise_signal(s)
         yield Path(tmp)
         os.chmod(tmp, 0o666 & ~_umask())
         os.replace(tmp, path)
     except BaseException as exc:
-        _release_signals(saved, [])
         if tmp is None:
             raise
         with contextlib.suppress(FileNotFoundError):
@@ -76,28 +76,6 @@ def atomic_path(path: str | os.PathLike):
         if isinstance(exc, OSError) and exc.filename in (tmp, Path(tmp)):
             raise OSError(exc.errno, exc.strerror, str(path)) from None
         raise
-
-
-def _hold_signals(held: list[int]) -> dict:
-    """In the main thread (the only one Python's signal handlers interrupt), replace the
-    SIGINT and SIGTERM handlers by one that appends the signal to ``held``; returns the
-    replaced handlers (none in another thread)."""
-    if threading.current_thread() is not threading.main_thread():
-        return {}
-    saved = {}
-    for s in (signal.SIGINT, signal.SIGTERM):
-        if signal.getsignal(s) is not None:  # None: a handler not set from Python, left alone
-            saved[s] = signal.signal(s, lambda signum, frame: held.append(signum))
-    return saved
-
-
-def _release_signals(saved: dict, held: list[int]) -> None:
-    """Put the ``saved`` handlers back, then raise each ``held`` signal again (its handler
-    runs before :func:`signal.raise_signal` returns)."""
-    for s, handler in saved.items():
-        signal.signal(s, handler)
-    for s in dict.fromkeys(held):
-        signal.raise_signal(s)
 
 
 def _alive(pid: int) -> bool:
