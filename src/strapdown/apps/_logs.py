@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import contextlib
 import json
+import math
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -124,6 +125,18 @@ class PairedOutput:
     meta: dict[str, Any] = field(default_factory=dict)
 
 
+def _strict_json(x: Any) -> Any:
+    """``x`` with every non-finite float as the string ``"nan"``, ``"inf"`` or ``"-inf"``:
+    JSON has no such numbers (Python's ``NaN``/``Infinity`` tokens are not JSON)."""
+    if isinstance(x, float) and not math.isfinite(x):
+        return "nan" if math.isnan(x) else ("inf" if x > 0 else "-inf")
+    if isinstance(x, dict):
+        return {k: _strict_json(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_strict_json(v) for v in x]
+    return x
+
+
 @contextlib.contextmanager
 def output_with_sidecar(out: Path) -> Iterator[PairedOutput]:
     """Write ``out`` and ``OUT.meta.json`` together (see the module docstring).
@@ -140,7 +153,8 @@ def output_with_sidecar(out: Path) -> Iterator[PairedOutput]:
                 yield paired
                 if not paired.meta:
                     raise RuntimeError("output_with_sidecar: no metadata was given")
-                meta_tmp.write_text(json.dumps(paired.meta, indent=2, ensure_ascii=False)
+                meta_tmp.write_text(json.dumps(_strict_json(paired.meta), indent=2,
+                                               ensure_ascii=False, allow_nan=False)
                                     + "\n", encoding="utf-8")
                 meta_path.unlink(missing_ok=True)  # no stale sidecar for the new OUT
             landed = True

@@ -32,7 +32,6 @@ base and jitter, gaps, warnings, version), the two written together
 from __future__ import annotations
 
 import dataclasses
-import math
 import warnings
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
@@ -374,7 +373,5 @@ def _metadata(imu: Path, log: AhrsLog, res: AhrsResult, algorithm: str, frame: s
         "time_base": base.describe(), "on_gap": on_gap,
         "gaps": {"count": len(log.gaps), "first_rows": log.gaps[:100]},
         "warnings": caught, "version": __version__,
-        # JSON has no infinity: an unlimited budget is written as the string "inf".
-        "config": {k: "inf" if isinstance(v, float) and math.isinf(v) else v
-                   for k, v in asdict(res.config).items()},
+        "config": asdict(res.config),
     }
