@@ -51,6 +51,17 @@ def test_kernel_rates_are_the_earth_model():
     assert earth.gravity(math.pi / 2) == pytest.approx(9.8321849378, abs=1e-9)
 
 
+def _flight_inputs(fl: EarthFlight, structure: str, **extra):
+    """600 steps of 10 ms of ``fl``: its increments, and :func:`navigate`'s keywords for
+    starting from its initial state (plus ``extra``)."""
+    h = 0.01
+    g, a = fl.increments(np.arange(601) * h)
+    s0 = fl.state(np.array([0.0]))
+    kw = {"h": h, "lat": fl.lat0, "lon": fl.lon0, "height": fl.h0, "q0": s0.q[0],
+          "v0": s0.velocity[0], "structure": structure, **extra}
+    return g, a, kw
+
+
 @pytest.mark.parametrize(("structure", "n"), [("conventional", 2), ("single-chain", 3)])
 def test_kernel_equals_plain_twin(structure, n):
     from strapdown._core.backend import NUMPY
@@ -59,17 +70,13 @@ def test_kernel_equals_plain_twin(structure, n):
 
     fl = EarthFlight([EarthSegment(2.0), EarthSegment(4.0, 6.0, 8.0)], lat_deg=50.0,
                      speed=120.0, ramp=3.0)
-    h = 0.01
-    g, a = fl.increments(np.arange(601) * h)
-    s0 = fl.state(np.array([0.0]))
-    kw = {"h": h, "lat": fl.lat0, "lon": fl.lon0, "height": fl.h0, "q0": s0.q[0],
-          "v0": s0.velocity[0], "structure": structure}
+    g, a, kw = _flight_inputs(fl, structure)
     sol = navigate(g, a, n, **kw)
-    b = body_increments(g, a, n, h=h, structure=structure)
+    b = body_increments(g, a, n, h=kw["h"], structure=structure)
     body = [(tuple(map(float, p)), tuple(map(float, d))) for p, d in zip(b.phi, b.dv,
                                                                        strict=True)]
     ps, vs, qs = ref.earth_nav(body, b.update_period, (fl.lat0, fl.lon0, fl.h0),
-                               tuple(map(float, s0.velocity[0])), tuple(map(float, s0.q[0])),
+                               tuple(map(float, kw["v0"])), tuple(map(float, kw["q0"])),
                                NUMPY)
     assert np.allclose(np.array(ps)[:, :2], np.stack([sol.lat, sol.lon], 1), rtol=0,
                        atol=1e-15)
@@ -160,11 +167,7 @@ def test_stream_equals_navigate_bit_for_bit(structure, n):
 
     fl = EarthFlight([EarthSegment(3.0), EarthSegment(3.0, 5.0, 4.0)], lat_deg=40.0,
                      speed=90.0, ramp=2.0)
-    h = 0.01
-    g, a = fl.increments(np.arange(601) * h)
-    s0 = fl.state(np.array([0.0]))
-    kw = {"h": h, "lat": fl.lat0, "lon": fl.lon0, "height": fl.h0, "q0": s0.q[0],
-          "v0": s0.velocity[0], "structure": structure, "t0": 2.5}
+    g, a, kw = _flight_inputs(fl, structure, t0=2.5)
     sol = navigate(g, a, n, **kw)
     stream = NavStream(n, **kw)
     cuts = [0, 0, 1, 2, 3, 50, 51, 200, 333, 598, 600]  # chunks shorter than N, empty ones too
