@@ -139,12 +139,13 @@ def test_bias_is_estimated_at_rest_and_then_in_motion():
     assert err[t[r.index] > 1].max() < math.radians(0.5)
 
 
-def _anomalous_field(t, q, stop):
-    """A body-fixed 19 µT anomaly from 20 s to ``stop`` (a magnet carried along: at some
-    orientations the field's norm and dip look undisturbed, only the gate sees it)."""
+def _anomalous_field(t, q, stop, anomaly=(15.0, -10.0, 5.0)):
+    """A body-fixed ``anomaly`` (µT) from 20 s to ``stop``; by default 19 µT (a magnet
+    carried along: at some orientations the field's norm and dip look undisturbed, only
+    the gate sees it)."""
     from strapdown.truth import sensors
 
-    errs = sensors.MagnetometerErrors(white_noise=0.2, anomaly=[15.0, -10.0, 5.0],
+    errs = sensors.MagnetometerErrors(white_noise=0.2, anomaly=list(anomaly),
                                       anomaly_start=20.0, anomaly_stop=stop)
     return sensors.magnetometer(t, q, M_N, errors=errs, rng=3)
 
@@ -231,14 +232,11 @@ def test_the_backward_pass_has_its_own_rejection_budget():
     and the smoothed error is smaller than with the backward budget as short as the
     forward one."""
     from strapdown.ahrs import offline_ekf
-    from strapdown.truth import sensors
 
     h = 1 / 100
     t = np.arange(int(60 / h)) * h
     q, w, acc, _ = _imu(_motion(), t)
-    errs = sensors.MagnetometerErrors(white_noise=0.2, anomaly=[2.0, -1.5, 9.0],
-                                      anomaly_start=20.0, anomaly_stop=35.0)
-    mag = sensors.magnetometer(t, q, M_N, errors=errs, rng=3)
+    mag = _anomalous_field(t, q, stop=35.0, anomaly=(2.0, -1.5, 9.0))
     short = AhrsConfig(gyro_sample="point", mag_reject_s=2.0, offline_mag_reject_s=2.0)
     unlimited = AhrsConfig(gyro_sample="point", mag_reject_s=2.0)
     a, b = (ekf(t, w, acc, mag, q0=q[0], mag_reference=M_N, config=c) for c in (short, unlimited))
