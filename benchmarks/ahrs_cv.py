@@ -40,26 +40,15 @@ PRIOR = {"gyro_noise": 1e-3, "gyro_bias_rw": 1e-5, "tilt_rate_noise": 0.003,
          "acc_lowpass_s": 3.0, "acc_lowpass_noise": 0.018, "heading_noise": 0.018,
          "mag_gate": 10.83, "mag_dip_tol": 0.1745, "rest_gyro": 0.01,
          "rest_acc": 0.2, "gyro_sample": "interval", "heading_rate_noise": 0.0}
-#: Not searched: how long a field the norm/dip check calls disturbed is rejected outright,
-#: and how it is de-weighted after that. A fold without attached magnets had learned a
-#: 60 s rejection with a narrow norm tolerance, and the held-out 4 cm magnet (a mild,
-#: 50 s disturbance during motion) lost 3.8× to VQF on the gyro's own drift. The budget
-#: is set from the gyro instead: on BROAD the gyro alone drifts in heading by up to
-#: ≈ 0.1 °/s in hand-held motion (trial 04: 13° over the trial, trial 35: 9° over 90 s,
-#: VQF's 6D estimate alike), so after 10 s of rejection it is about 1° off — as much as a
-#: mildly disturbed field does de-weighted by VQF's factor 2 and behind the innovation
-#: gate, which keeps rejecting what disagrees with the gyro. Values chosen after seeing
-#: the held-out figures (docs/reproductions.md).
-#: Nor the field's norm tolerance: the folds had learned 3.5-7 %, narrower than the lab
-#: field's own variation on the undisturbed trials (-3 % .. +11 %, 5th-95th percentile of
-#: the norm's departure from its initial value), so undisturbed motion was rejected as a
-#: disturbance. 12 % lies above that variation and below what the attached 4 cm magnet
-#: adds (17-20 %). Also chosen after seeing the held-out figures.
+#: Not searched: the rejection budget, its de-weighting, and the field's norm tolerance,
+#: fixed from measured quantities (the gyro's heading drift; the undisturbed field's own
+#: variation) after seeing held-out figures; why, in AhrsConfig's docstring and
+#: docs/reproductions.md.
 FIXED = {"mag_reject_s": 10.0, "mag_disturbed_factor": 2.0, "mag_disturbed_power": 0.0,
          "mag_norm_tol": 0.12}
-#: Each parameter's candidates, as multiples of its current value (or fixed values).
+#: Each parameter's candidates, as multiples of its current value (or these values).
 _STEPS = (0.5, 0.7, 1.4, 2.0)
-_FIXED = {"mag_gate": (4.0, 6.63, 10.83, 20.0, 1e9),
+_CHOICES = {"mag_gate": (4.0, 6.63, 10.83, 20.0, 1e9),
           "gyro_sample": ("interval", "point"),
           "heading_rate_noise": (0.0, 0.0005, 0.001, 0.002, 0.004)}
 _MOTION = ("rotation", "translation", "combined")
@@ -111,7 +100,7 @@ def tune(trials, start: dict, rounds: int = 2) -> tuple[dict, float]:
     for _ in range(rounds):
         improved = False
         for k in start:
-            cands = _FIXED.get(k) or tuple(cur[k] * f for f in _STEPS)
+            cands = _CHOICES.get(k) or tuple(cur[k] * f for f in _STEPS)
             for v in cands:
                 if v == cur[k]:
                     continue
