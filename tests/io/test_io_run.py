@@ -36,15 +36,21 @@ def test_deg_per_s_declared_as_rad_per_s_warns(tmp_path):
 
 
 def test_duplicated_timestamp_fails_with_row_and_writes_nothing(tmp_path, capsys):
+    """A duplicated stamp with different values is an error naming both rows and the option
+    that resolves it (one with identical values is dropped: tests/io/test_timing.py)."""
     t = np.arange(10) / 100.0
     t[6] = t[5]
-    _csv(tmp_path / "log.csv", t, np.zeros((10, 3)))
+    w = np.zeros((10, 3))
+    w[:, 0] = np.arange(10) * 0.01
+    _csv(tmp_path / "log.csv", t, w)
     out = tmp_path / "att.csv"
     with pytest.raises(SystemExit) as exc:
         main(["run", "--imu", str(tmp_path / "log.csv"), "--rates", "--units", "rad/s",
               "--algorithm", "rk4", "--out", str(out)])
     assert exc.value.code == 2
-    assert "duplicated time stamp in data row 7" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "duplicated time stamp in data rows 6 and 7" in err
+    assert "--duplicate-stamps first" in err
     assert not out.exists() and list(tmp_path.iterdir()) == [tmp_path / "log.csv"]
 
 

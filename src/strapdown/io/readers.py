@@ -57,6 +57,15 @@ from strapdown._core.limits import check_bytes
 from strapdown._core.validation import first_bad_step
 from strapdown.io.containers import open_npy, read_hdf5, read_mat, read_npz
 from strapdown.io.files import atomic_path
+from strapdown.io.timing import (
+    JITTER_TOLERANCE,
+    DuplicatePolicy,
+    HeldPolicy,
+    Timing,
+    TimingMode,
+    reconstruct,
+    relative_times,
+)
 
 __all__ = [
     "ACC_COLUMNS",
@@ -84,15 +93,19 @@ __all__ = [
     "UnitAction",
     "UnitWarning",
     "canonical_unit",
+    "check_distinct_columns",
+    "check_finite_rows",
     "check_motion",
     "check_read_options",
     "check_rows",
     "check_steps",
+    "column_index",
     "csv_columns",
     "csv_header",
     "default_columns",
     "file_rate",
     "input_file",
+    "log_kind",
     "npy_log",
     "read_imu",
     "time_scale",
@@ -148,6 +161,9 @@ class ImuLog:
     nominal_period : float or None
         The sensor's period (s) when a sample rate was given for a stamped log
         (``1 / sample_rate_hz``); None: the period comes from the stamps.
+    timing : Timing or None
+        The time base (:mod:`strapdown.io.timing`): rows dropped or collapsed, the fitted
+        clock, how the stamps are taken; ``t`` and ``data`` hold the samples kept.
     """
 
     t: NDArray[np.float64]
@@ -158,6 +174,7 @@ class ImuLog:
     saturated: list[int] = field(default_factory=list)
     units: str | None = None
     nominal_period: float | None = None
+    timing: Timing | None = None
 
     def segments(self) -> list[slice]:
         """Index ranges between gaps: each a gap-free run of samples.
@@ -244,11 +261,77 @@ def _header_line(path: Path, f, delimiter: str | None) -> tuple[list[str], str]:
         raise InputError(f"{path}: the header row is longer than {MAX_HEADER_CHARS} characters; "
                          "expected a CSV with a header row")
     d = _delimiter(path, line, delimiter)
+    return _cells(path, line, d), d
+
+
+def _cells(path: Path, line: str, d: str) -> list[str]:
     try:
-        cells = next(csv.reader([line.rstrip("\r\n")], delimiter=d))
+        return next(csv.reader([line.rstrip("\r\n")], delimiter=d))
     except (csv.Error, StopIteration) as exc:
         raise InputError(f"{path}: unreadable header row ({exc})") from None
-    return cells, d
+
+
+#: Units a second header row may hold (besides time units, gyro units and the spellings of
+#: :data:`UNIT_SPELLINGS`): a cell of that row that is one of them is the column's unit; any
+#: other cell names the column within the group above it.
+HEADER_UNITS = frozenset({"rad/s", "deg/s", "rad", "deg", "m/s2", "g", "m/s", "ut", "µt",
+                          "nt", "gauss", "mg", "a.u.", "au", "counts", "lsb"})
+
+
+def _is_number(cell: str) -> bool:
+    try:
+        float(cell)
+    except ValueError:
+        return False
+    return True
+
+
+def _is_unit(cell: str) -> bool:
+    c = canonical_unit(cell.strip().strip("[]()"))
+    return c in TIME_UNITS or c.lower() in HEADER_UNITS
+
+
+def _second_row(path: Path, f, d: str, first: list[str]) -> list[str] | None:
+    """The second header row's cells when the line after the header is one (a row of the
+    header's width none of whose cells is a number, e.g. units ``s;W;X;Y;Z``); the file
+    position is left after it, else where it was."""
+    pos = f.tell()
+    try:
+        line = f.readline(MAX_HEADER_CHARS + 1)
+    except UnicodeDecodeError:
+        f.seek(pos)
+        return None
+    cells = _cells(path, line, d) if line.strip() else []
+    if not cells or any(_is_number(c) for c in cells if c.strip()) or len(cells) != len(first):
+        f.seek(pos)
+        return None
+    return cells
+
+
+def _merge_rows(first: list[str], second: list[str] | None) -> tuple[list[str], dict[str, str]]:
+    """Column names and units of one or two header rows.
+
+    The first row's names and bracketed units (``gx[deg/s]``); with a second row, a group
+    name spans the empty cells to its right, and each second-row cell is the column's unit
+    when it is one (``s``, ``rad/s``, ``m/s^2``) or else its name within the group
+    (``IMU Gyroscope`` over ``X`` → ``IMU Gyroscope X``).
+    """
+    names, units = _split_header(first)
+    if second is None:
+        return names, units
+    group = ""
+    out: list[str] = []
+    for j, (name, cell) in enumerate(zip(names, second, strict=True)):
+        group = name or group
+        sub = cell.strip()
+        if sub and not _is_unit(sub):
+            full = f"{group} {sub}".strip()
+        else:
+            full = name or f"{group} {j}".strip()
+            if sub:
+                units[full] = canonical_unit(sub.strip("[]()"))
+        out.append(full)
+    return out, units
 
 
 def _text(path: Path):
@@ -258,16 +341,20 @@ def _text(path: Path):
 
 def csv_header(path: str | os.PathLike[str], *, delimiter: str | None = None
                ) -> tuple[list[str], dict[str, str]]:
-    """The column names of a CSV's header row and the units it declares by name.
+    """The column names of a CSV's header and the units it declares by name.
 
     ``delimiter``: one of :data:`DELIMITERS` (``"tab"`` for a tab), or None to take the
     first of them the header row contains. A UTF-8 byte-order mark and CRLF line ends are
-    read as plain text.
+    read as plain text. A second header row (a line with cells that are not numbers) is
+    read too: its units (``s``, ``rad/s`` …) are the columns' units, its other cells name
+    the columns within the group names of the first row, whose empty cells continue the
+    group to their left (:func:`_merge_rows`).
     """
     path = Path(path)
     with _text(path) as f:
-        cells, _ = _header_line(path, f, delimiter)
-    return _split_header(cells)
+        cells, d = _header_line(path, f, delimiter)
+        second = _second_row(path, f, d, cells)
+    return _merge_rows(cells, second)
 
 
 def default_columns(path: str | os.PathLike[str],
@@ -330,28 +417,44 @@ def _csv_budget(path: Path, ncols: int) -> None:
     check_bytes(path, int(size / mean + 1) * ncols * 8, "its values")
 
 
+def column_index(header: Sequence[str], selector: str | int) -> int | None:
+    """The index of a column given by name, or by 0-based index (an int or a string of
+    digits); None when the header has no such column."""
+    if isinstance(selector, int) or (isinstance(selector, str) and selector.strip().isdigit()):
+        i = int(selector)
+        return i if 0 <= i < len(header) else None
+    return header.index(selector) if selector in header else None
+
+
 def csv_columns(path: str | os.PathLike[str], columns: Sequence[str],
                 optional: Sequence[str] = (), *, delimiter: str | None = None
                 ) -> tuple[NDArray[np.float64], dict[str, str], bool]:
-    """Named columns of a CSV log with a header row.
+    """Columns of a CSV log with a header row, by name or by 0-based index.
 
     Returns ``(values, units, have_optional)``: ``values`` holds ``columns``
     followed by ``optional`` when every optional column is present, ``units``
-    the header's bracketed units by column name (``gx[deg/s]``). Errors name
+    the header's units by column name (``gx[deg/s]``, or a second header row) and by
+    each selector given (so an index ``"8"`` finds its column's unit). Errors name
     missing columns, a file without data rows, unreadable numbers and rows
     whose field count differs from the header's. ``delimiter``: as :func:`csv_header`.
     """
     path = Path(path)
     with _text(path) as f:
         cells, d = _header_line(path, f, delimiter)
-        header, units = _split_header(cells)
-        missing = [c for c in columns if c not in header]
+        second = _second_row(path, f, d, cells)
+        header, units = _merge_rows(cells, second)
+        missing = [c for c in columns if column_index(header, c) is None]
         if missing:
             raise InputError(f"{path}: columns {shown(missing, 100)} not in the header "
-                             f"{shown(header, 160)}; map them with --columns")
-        have_optional = bool(optional) and all(c in header for c in optional)
+                             f"{shown(header, 160)} ({len(header)} columns, 0-based indices "
+                             f"0-{len(header) - 1}); map them with --columns")
+        have_optional = bool(optional) and all(column_index(header, c) is not None
+                                               for c in optional)
         wanted = list(columns) + (list(optional) if have_optional else [])
-        idx = [header.index(c) for c in wanted]
+        idx = [int(column_index(header, c) or 0) for c in wanted]  # every one found above
+        for sel, i in zip(wanted, idx, strict=True):
+            if header[i] in units:
+                units[str(sel)] = units[header[i]]
         _csv_budget(path, len(header))
         raw = _csv_values(path, f, d, len(header))
     return raw[:, idx], units, have_optional
@@ -378,7 +481,8 @@ def _csv_values(path: Path, f, delimiter: str, ncols: int) -> NDArray[np.float64
 
 
 def _load_csv(path: Path, columns, delimiter: str | None):
-    """``(t [s], axes, header unit of the axes)``; ``columns`` None: :func:`default_columns`."""
+    """``(t in its own unit, axes, header unit of the axes, seconds per unit of t)``;
+    ``columns`` None: :func:`default_columns`."""
     if columns is None:
         columns, _ = default_columns(path, [("gyro", GYRO_COLUMNS)], delimiter=delimiter)
     raw, units, _ = csv_columns(path, columns, delimiter=delimiter)
@@ -387,8 +491,7 @@ def _load_csv(path: Path, columns, delimiter: str | None):
         raise InputError(f"{path}: the header gives the axes different units "
                          f"{shown(sorted(axis_units), 80)}")
     scale = time_scale(path, columns[0], units)
-    t = raw[:, 0] * scale if scale != 1.0 else raw[:, 0]
-    return t, raw[:, 1:4], (axis_units.pop() if axis_units else None)
+    return raw[:, 0], raw[:, 1:4], (axis_units.pop() if axis_units else None), scale
 
 
 #: Shortest time step accepted (s): an IMU samples at most at 1 GHz.
@@ -502,6 +605,7 @@ class _Source:
     note: str = ""
     kind: InputKind | None = None  # what a known format holds
     what: str = ""  # the format, for messages
+    scale: float = 1.0  # seconds per unit of t (t[ms]: 1e-3), applied by read_imu
 
 
 def file_rate(path: str | os.PathLike[str], value: ArrayLike | None) -> float | None:
@@ -580,8 +684,8 @@ def _load(path: Path, columns, sample_rate_hz, delimiter) -> _Source:
     """Stamps, gyro values and what the file says of itself, from any supported file."""
     suffix = path.suffix.lower()
     if suffix in (".csv", ".txt", ".tsv"):
-        t, g, units = _load_csv(path, columns, delimiter)
-        return _Source(t, g, units)
+        t, g, units, scale = _load_csv(path, columns, delimiter)
+        return _Source(t, g, units, scale=scale)
     if suffix in (".h5", ".hdf5"):
         return _load_hdf5(path, sample_rate_hz)
     if suffix == ".npy":
@@ -623,12 +727,14 @@ def _declared_units(path: Path, src: _Source, kind: InputKind, units: str | None
 
 def check_read_options(*, kind: object, units: object, gap_tolerance: object, on_gap: object,
                        saturation: object, sample_rate_hz: object,
-                       columns: Sequence[str] | None = None) -> None:
+                       columns: Sequence[str] | None = None, kind_optional: bool = False
+                       ) -> None:
     """The reading options every input route shares (:func:`read_imu`, the streamed
     ``.npy`` path of ``strapdown run``), checked before any file is opened."""
-    if kind not in INPUT_KINDS:
+    if kind not in INPUT_KINDS and not (kind_optional and kind is None):
         raise InputError(f"kind must be 'rate' or 'increment', got {shown(kind, 20)}")
-    allowed: tuple[GyroUnit, ...] = RATE_UNITS if kind == "rate" else INCREMENT_UNITS
+    allowed: tuple[GyroUnit, ...] = (RATE_UNITS if kind == "rate" else INCREMENT_UNITS
+                                     if kind == "increment" else RATE_UNITS + INCREMENT_UNITS)
     if units is not None and units not in allowed:
         raise InputError(f"{kind} units must be one of {allowed}, got {shown(units, 20)}")
     if on_gap not in GAP_POLICIES:
@@ -645,6 +751,21 @@ def check_read_options(*, kind: object, units: object, gap_tolerance: object, on
                          f"{shown(sample_rate_hz, 20)}")
     if columns is not None and len(columns) != 4:
         raise InputError(f"columns must name time and three axes, got {shown(columns, 80)}")
+    check_distinct_columns(columns)
+
+
+def check_distinct_columns(columns: Sequence[str] | None) -> None:
+    """Raise when a column is named twice (``--columns t,t,t,t`` would integrate the time
+    column as the gyro)."""
+    if columns is None:
+        return
+    seen: dict[str, int] = {}
+    for i, c in enumerate(columns):
+        key = str(c).strip()
+        if key in seen:
+            raise InputError(f"--columns names {shown(key, 40)} twice (positions {seen[key] + 1} "
+                             f"and {i + 1}); each of time and the axes needs its own column")
+        seen[key] = i
 
 
 def _as_float(x: object) -> float:
@@ -665,16 +786,20 @@ def input_file(path: str | os.PathLike[str], what: str = "file") -> Path:
     return path
 
 
-def read_imu(path: str | os.PathLike[str], *, kind: InputKind, units: GyroUnit | None,
+def read_imu(path: str | os.PathLike[str], *, kind: InputKind | None, units: GyroUnit | None,
              columns: Sequence[str] | None = None,
              sample_rate_hz: float | None = None, gap_tolerance: float = 1.5,
              on_gap: GapPolicy = "report", saturation: float | None = None,
-             unit_check: UnitAction = "warn", delimiter: str | None = None) -> ImuLog:
+             unit_check: UnitAction = "warn", delimiter: str | None = None,
+             timing_mode: TimingMode = "auto", jitter_tolerance: float = JITTER_TOLERANCE,
+             held: HeldPolicy = "auto", duplicates: DuplicatePolicy = "error") -> ImuLog:
     """Read and validate a gyro log (see the module docstring).
 
     Parameters
     ----------
-    kind : {"rate", "increment"}
+    kind : {"rate", "increment"} or None
+        None: from a known format, or from the header's unit (``gx[rad/s]``: rates,
+        ``gx[rad]``: increments); an error when neither says.
     units : {"rad/s", "deg/s"} for rates, {"rad", "deg"} for increments, or None
         None takes the unit from the file: a CSV header (``gx[deg/s]``) or a format whose
         unit is known (BROAD: rad/s); it is an error when the file declares none, and when
@@ -698,6 +823,18 @@ def read_imu(path: str | os.PathLike[str], *, kind: InputKind, units: GyroUnit |
         What magnitudes that suggest the other unit do (:func:`warn_implausible_rate`).
     delimiter : str, optional
         A CSV's delimiter (:data:`DELIMITERS`); default: detected from the header row.
+    timing_mode : {"auto", "nominal", "stamps", "resample"}
+        How the stamps are taken (:data:`strapdown.io.timing.TimingMode`): the sensor's
+        clock is fitted to them (:func:`strapdown.io.timing.reconstruct`) and recorded in
+        :attr:`ImuLog.timing`; with the samples on that clock a gap is whole missing
+        periods, otherwise an interval over ``gap_tolerance`` periods.
+    jitter_tolerance : float
+        Largest stamp residual (periods, 99th percentile) that is noise on the clock.
+    held : {"auto", "collapse", "keep"}
+        Held samples (rows repeating the previous sample): collapsed when the clock
+        confirms them, always, or never (:func:`strapdown.io.timing.clean_rows`).
+    duplicates : {"error", "first", "last"}
+        A duplicated stamp with different values: an error naming the rows, or keep one.
 
     Raises
     ------
@@ -708,30 +845,52 @@ def read_imu(path: str | os.PathLike[str], *, kind: InputKind, units: GyroUnit |
         :data:`MIN_PERIOD` are errors too.
     """
     check_read_options(kind=kind, units=units, gap_tolerance=gap_tolerance, on_gap=on_gap,
-                       saturation=saturation, sample_rate_hz=sample_rate_hz, columns=columns)
+                       saturation=saturation, sample_rate_hz=sample_rate_hz, columns=columns,
+                       kind_optional=True)
     path = input_file(path, "log file")
     src = _load(path, None if columns is None else list(columns), sample_rate_hz, delimiter)
+    kind = _log_kind(path, src, kind)
     unit = _declared_units(path, src, kind, units)
-    t, g = src.t, src.gyro
-    if t.ndim != 1 or g.ndim != 2 or g.shape[1] != 3 or t.shape[0] != g.shape[0]:
+    raw, g = src.t, src.gyro
+    if raw.ndim != 1 or g.ndim != 2 or g.shape[1] != 3 or raw.shape[0] != g.shape[0]:
         raise InputError(f"{path}: expected n times of shape (n,) and gyro values of shape "
-                         f"(n, 3), got {t.shape} and {g.shape}")
-    if t.size < 2:
-        raise InputError(f"{path}: {t.size} samples; at least 2 are needed")
-    check_rows(path, t, [(None, [t, g])])
-    d = np.diff(t)
-    h = float(np.median(d))
+                         f"(n, 3), got {raw.shape} and {g.shape}")
+    if raw.size < 2:
+        raise InputError(f"{path}: {raw.size} samples; at least 2 are needed")
+    check_finite_rows(path, [(None, [raw, g])])
+    check_stamp_steps(path, raw, src.scale)
     stamped = src.what != "BROAD's imu_gyr"  # BROAD's times come from its rate
     nominal = 1.0 / sample_rate_hz if sample_rate_hz is not None and stamped else None
+    base = relative_times(raw, src.scale)
+    timing = reconstruct(path, base, g, period=nominal, mode=timing_mode, held=held,
+                         duplicates=duplicates, jitter_tolerance=jitter_tolerance,
+                         fit=stamped)
+    keep = timing.cleaning.keep
+    if keep.size < raw.size:
+        g = g[keep]
+    t_rel = base.t[keep]
+    # stamps as read (scaled) unless they are epoch-like, where only the exact relative
+    # times keep the intervals (the origin is kept in the timing record)
+    t = base.origin + t_rel if abs(base.origin) >= EPOCH_LIKE_S else raw[keep] * src.scale
+    if keep.size < 2:
+        raise InputError(f"{path}: {keep.size} distinct samples; at least 2 are needed")
+    d = np.diff(t_rel)
+    check_steps(path, d, t_rel)
+    clock = timing.clock
+    h = clock.period if clock is not None and timing.on_clock else float(np.median(d))
     unit_h = nominal or h
-    gaps = [int(i) + 2 for i in np.flatnonzero(d > gap_tolerance * unit_h)]
+    if clock is not None and timing.on_clock:
+        gaps = [int(timing.rows[i]) for i in clock.gap_rows()]
+    else:
+        gaps = [int(timing.rows[i + 1]) for i in np.flatnonzero(d > gap_tolerance * unit_h)]
     if gaps and on_gap == "error":
-        r = gaps[0]
-        raise InputError(f"{path}: gap of {d[r - 2]:.6g} s ({d[r - 2] / unit_h:.1f} sample "
-                         f"intervals) before data row {r}")
+        i = int(np.searchsorted(timing.rows, gaps[0]))
+        raise InputError(f"{path}: gap of {d[i - 1]:.6g} s ({d[i - 1] / unit_h:.1f} sample "
+                         f"intervals) before data row {gaps[0]}")
     saturated = []
     if saturation is not None:
-        saturated = [int(i) + 1 for i in np.flatnonzero(np.any(np.abs(g) >= saturation, axis=1))]
+        saturated = [int(timing.rows[i]) for i in
+                     np.flatnonzero(np.any(np.abs(g) >= saturation, axis=1))]
     scale = _DEG if unit.startswith("deg") else 1.0
     g = g * scale
     with np.errstate(over="ignore"):  # an overflowing rate is refused by check_motion
@@ -739,7 +898,82 @@ def read_imu(path: str | os.PathLike[str], *, kind: InputKind, units: GyroUnit |
     warn_implausible_rate(path, rate, unit, action=unit_check)
     check_motion(path, g, kind, unit_h)
     return ImuLog(np.asarray(t, float), np.ascontiguousarray(g), kind, h, gaps, saturated,
-                  unit, nominal)
+                  unit, nominal, timing)
+
+
+#: Stamps whose first value exceeds this (s, about 11.6 days) are epoch-like: the samples'
+#: times are formed as origin + exact relative time (float64 holds 1.7e9 s to 2.4e-7 s).
+EPOCH_LIKE_S = 1e6
+
+
+def check_stamp_steps(path: str | os.PathLike[str], raw: NDArray[np.float64],
+                      scale: float) -> None:
+    """Raise on a time step that overflows or is positive but under :data:`MIN_PERIOD`
+    (duplicated and decreasing stamps are judged later, with the rows' values)."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        d = np.diff(raw) * scale
+    bad = ~np.isfinite(d) | ((d > 0) & (d < MIN_PERIOD))
+    if np.any(bad):
+        i = int(np.argmax(bad))
+        raise InputError(f"{path}: time step of {float(d[i])!r} s before data row {i + 2}; "
+                         f"steps must be finite and at least {MIN_PERIOD:g} s (check the time "
+                         "unit)")
+
+
+def _log_kind(path: Path, src: _Source, kind: InputKind | None) -> InputKind:
+    """The kind given, else the one a known format holds or the header's unit says
+    (``gx[rad/s]``: rates, ``gx[rad]``: increments); else an error asking for it."""
+    if kind is not None:
+        return kind
+    if src.kind is not None:
+        return src.kind
+    if src.units in RATE_UNITS:
+        return "rate"
+    if src.units in INCREMENT_UNITS:
+        return "increment"
+    raise InputError(f"{path}: does the log hold rates or increments? Its header does not say "
+                     "(a unit such as gx[rad/s] or gx[rad] would); pass --rates or --increments")
+
+
+def log_kind(path: str | os.PathLike[str], columns: Sequence[str] | None = None, *,
+             delimiter: str | None = None) -> InputKind | None:
+    """What a CSV log's header says it holds (rates for ``gx[rad/s]``, increments for
+    ``gx[rad]``), None when it does not say or the file is not a CSV."""
+    path = Path(path)
+    if path.suffix.lower() not in (".csv", ".txt", ".tsv") or not path.is_file():
+        return None
+    try:
+        if columns is None:
+            columns, _ = default_columns(path, [("gyro", GYRO_COLUMNS)], delimiter=delimiter)
+        _, units = csv_header(path, delimiter=delimiter)
+    except InputError:
+        return None
+    names, _ = csv_header(path, delimiter=delimiter)
+    found = set()
+    for c in columns[1:]:
+        i = column_index(names, c)
+        if i is not None and names[i] in units:
+            found.add(units[names[i]])
+    if found and found <= set(RATE_UNITS):
+        return "rate"
+    if found and found <= set(INCREMENT_UNITS):
+        return "increment"
+    return None
+
+
+def check_finite_rows(path: str | os.PathLike[str],
+                      groups: Iterable[tuple[str | None, Iterable[ArrayLike]]]) -> None:
+    """Raise on the first non-finite row of each group (see :func:`check_rows`)."""
+    for label, arrays in groups:
+        bad: NDArray[np.bool_] | None = None
+        for a in arrays:
+            a = np.asarray(a)
+            b = ~np.isfinite(a) if a.ndim == 1 else ~np.all(np.isfinite(a), axis=1)
+            bad = b if bad is None else bad | b
+        if bad is not None and np.any(bad):
+            where = "" if label is None else f" the {label} at"
+            raise InputError(f"{path}: NaN or infinity in{where} data row "
+                             f"{int(np.argmax(bad)) + 1}")
 
 
 def write_attitude(path: str | os.PathLike[str], t: ArrayLike, q: NDArray[np.float64], *,
