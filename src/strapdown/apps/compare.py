@@ -9,7 +9,10 @@ are :class:`~strapdown.analysis.evaluate.EvaluationConfig` fields (``N`` is shor
 On a motion, errors are against the exact truth. On a log with a truth file
 (``t,qw,qx,qy,qz``: CSV, ``.npy`` of n × 5 or ``.npz``), the truth is slerped to
 each algorithm's output times (only times inside its span; the table says whether
-the outputs fall on truth samples or between them).
+the outputs fall on truth samples or between them). Truth times are seconds unless a CSV
+header declares their unit (``t[ms]``, ``t[us]``, ``t[ns]``); a truth whose times read in
+seconds span about 10³, 10⁶ or 10⁹ times the log's, and read in that unit match the log's
+span and sample rate, is refused (:func:`_check_time_base`): its times are in ms, µs or ns.
 
 On a log without truth nothing is interpolated: two algorithms are compared only at
 the output times they share (within 10⁻⁶ of a sample interval). The **reference** is
@@ -150,11 +153,24 @@ _TRUTH_FORMATS = "CSV with columns t,qw,qx,qy,qz, .npy of shape (n, 5) or .npz w
 def _read_truth(path: str | os.PathLike[str], delimiter: str | None = None
                 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """``(t, q)`` of a truth file (:data:`_TRUTH_FORMATS`), checked by :func:`_check_truth`;
-    binary files are read by :mod:`strapdown.io.containers` (structure validated first)."""
-    from strapdown.io.containers import open_npy, read_npz
-    from strapdown.io.readers import csv_columns, input_file, time_scale
+    binary files are read by :mod:`strapdown.io.containers` (structure validated first);
+    values beyond float64 (a float128 ``.npy``) read as infinity and are refused with their
+    row."""
+    from strapdown.io.readers import input_file
 
     path = input_file(path, "truth file")
+    with np.errstate(over="ignore", invalid="ignore"):  # overflowing values: refused below
+        t, q = _truth_values(path, delimiter)
+    _check_truth(path, t, q)
+    return t, q
+
+
+def _truth_values(path: Path, delimiter: str | None
+                  ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """The truth file's times (s) and quaternions as float64, unchecked."""
+    from strapdown.io.containers import open_npy, read_npz
+    from strapdown.io.readers import csv_columns, time_scale
+
     suffix = path.suffix.lower()
     if suffix == ".npz":
         z = read_npz(path, _TRUTH_COLUMNS)
@@ -180,7 +196,6 @@ def _read_truth(path: str | os.PathLike[str], delimiter: str | None = None
     else:
         raise InputError(f"{path}: unknown truth format {shown(path.suffix, 20)}; truth must "
                          f"be {_TRUTH_FORMATS}")
-    _check_truth(path, t, q)
     return t, q
 
 
@@ -191,11 +206,14 @@ def _check_truth(path: Path, t: NDArray[np.float64], q: NDArray[np.float64]) -> 
     bad = np.flatnonzero(~(np.isfinite(t) & np.all(np.isfinite(q), axis=1)))
     if bad.size:
         raise InputError(f"{path}: NaN or infinity in truth row {bad[0] + 1}")
-    step = np.flatnonzero(~(np.diff(t) > 0))
+    with np.errstate(over="ignore"):  # an overflowing step is still an increase
+        step = np.flatnonzero(~(np.diff(t) > 0))
     if step.size:
         raise InputError(f"{path}: truth times must increase strictly; row {step[0] + 2} "
                          f"(t = {t[step[0] + 1]!r}) does not")
-    norm = np.linalg.norm(q, axis=1)
+    big = np.max(np.abs(q), axis=1)  # the norm without overflow (quaternions × 1e300)
+    scale = np.where(big > 0, big, 1.0)
+    norm = big * np.linalg.norm(q / scale[:, None], axis=1)
     off = np.flatnonzero(np.abs(norm - 1.0) > 1e-3)
     if off.size:
         raise InputError(f"{path}: truth row {off[0] + 1} is not a unit quaternion (norm "
@@ -288,9 +306,11 @@ def compare_log(imu: str | os.PathLike[str], specs: Iterable[str], out: str | os
     fields = [parse_spec(s) for s in specs]
     if on_gap not in ("report", "error", "split"):
         raise InputError(f"on_gap must be report, error or split, got {shown(on_gap, 20)}")
-    log = read_imu(imu, kind=kind, units=units, columns=columns, sample_rate_hz=sample_rate_hz,
-                   gap_tolerance=gap_tolerance, on_gap="error" if on_gap == "error" else "report",
-                   unit_check=unit_action(accept_unit_warning), delimiter=delimiter)
+    with np.errstate(over="ignore", invalid="ignore"):  # values beyond float64: refused
+        log = read_imu(imu, kind=kind, units=units, columns=columns,  # with their row
+                       sample_rate_hz=sample_rate_hz, gap_tolerance=gap_tolerance,
+                       on_gap="error" if on_gap == "error" else "report",
+                       unit_check=unit_action(accept_unit_warning), delimiter=delimiter)
     segments, base = log_segments(Path(imu), log, split=on_gap == "split", resample=resample,
                                   min_samples=max(_log_spec(f).min_samples for f in fields))
     h = segments[0].h
@@ -308,6 +328,7 @@ def compare_log(imu: str | os.PathLike[str], specs: Iterable[str], out: str | os
         _write(out, runs, title, what, progress, ylabel=ylabel, pairs=pairs)
         return runs
     t_ref, q_ref = _read_truth(truth, delimiter)
+    _check_time_base(Path(truth), t_ref, log, delimiter)
     q0 = _truth_start(truth, t_ref, q_ref, log, tol)
     sols = [_run_on_log(segments, f, q0) for f in fields]
     name = Path(truth).name
@@ -323,6 +344,53 @@ def compare_log(imu: str | os.PathLike[str], specs: Iterable[str], out: str | os
     _write(out, runs, title, f"error against {name}", progress,
            ylabel=f"attitude error against {name} (rad)")
     return runs
+
+
+#: Time units a truth's plain ``t`` may be in by mistake, and their factor to seconds.
+_TIME_SLIPS = (("ms", 1e-3), ("us", 1e-6), ("ns", 1e-9))
+
+
+def _covered(a0: float, a1: float, b0: float, b1: float) -> float:
+    """The fraction of the span ``b0…b1`` that ``a0…a1`` covers."""
+    return max(0.0, min(a1, b1) - max(a0, b0)) / (b1 - b0)
+
+
+def _check_time_base(path: Path, t_ref: NDArray[np.float64], log,
+                     delimiter: str | None) -> None:
+    """Refuse a truth whose undeclared times are in ms, µs or ns instead of seconds.
+
+    With a factor ``s`` of :data:`_TIME_SLIPS` the truth is taken for one in that unit when
+    its times times ``s`` cover at least half the log's span, its sample period times ``s``
+    is closer to the log's than its period read in seconds (in ratio), and read in seconds
+    the truth spans at least 100 times the log or covers less than half of it. A CSV
+    header that declares the unit (``t[s]``, ``t[ms]``) is taken as it says.
+    """
+    if path.suffix.lower() in (".csv", ".txt", ".tsv"):
+        from strapdown.io.readers import csv_header
+
+        if "t" in csv_header(path, delimiter=delimiter)[1]:
+            return
+    lo = float(log.t[0]) - (log.h if log.kind == "increment" else 0.0)
+    hi = float(log.t[-1])
+    t0, t1 = float(t_ref[0]), float(t_ref[-1])
+    with np.errstate(over="ignore"):
+        period = float(np.median(np.diff(t_ref)))
+    if not (hi > lo and log.h > 0 and math.isfinite(t1 - t0) and math.isfinite(period)):
+        return
+    raw = _covered(t0, t1, lo, hi)
+    if not ((t1 - t0) >= 100 * (hi - lo) or raw < 0.5):
+        return
+    for unit, s in _TIME_SLIPS:
+        if (_covered(s * t0, s * t1, lo, hi) >= 0.5
+                and abs(math.log(s * period / log.h)) < abs(math.log(period / log.h))):
+            declare = ("declare it in the header (t[" + unit + "]) or write the times in "
+                       "seconds" if path.suffix.lower() in (".csv", ".txt", ".tsv")
+                       else "write its t in seconds")
+            raise InputError(
+                f"{path}: truth times {t0:.6g}…{t1:.6g} (period {period:.3g}) do not fit the "
+                f"log's {lo:.6g}…{hi:.6g} s (period {log.h:.3g} s) as seconds, but do as "
+                f"{unit}: the truth's time column is likely in {unit}; {declare}; nothing "
+                "computed")
 
 
 def _truth_start(truth, t_ref: NDArray[np.float64], q_ref: NDArray[np.float64], log,
