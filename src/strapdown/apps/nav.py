@@ -14,10 +14,16 @@ gap detection); the accelerometer by the small reader here, on the same helpers
 because ``read_imu`` reads gyro axes only.
 
 Validation: a log without accelerometer columns, a unit the file contradicts, NaN or
-infinity (row named), gaps and non-uniform stamps are errors; so is an accelerometer whose
-median norm suggests the other unit (≈ 1 declared as m/s²: the log is in g — gravity alone
-gives 9.8 m/s² — or ≈ 9.8 declared as g) unless ``accept_unit_warning``. The initial state
-(latitude within ±90°, everything finite) is checked before the log is read.
+infinity (row named), gaps and non-uniform stamps are errors; so is a specific force beyond
+:data:`MAX_SPECIFIC_FORCE` (row named; increments: over their interval) and an
+accelerometer whose median norm suggests the other unit (≈ 1 declared as m/s²: the log is
+in g — gravity alone gives 9.8 m/s² — or ≈ 9.8 declared as g) unless
+``accept_unit_warning``. The initial state is checked before the log is read: everything
+finite, latitude within ±90°, longitude within ±:data:`MAX_LONGITUDE_DEG` (either
+convention, −180…180° or 0…360°; the output continues from the value given), height within
+:data:`HEIGHT_RANGE_M` (the deepest ocean trench to 1000 km: the second-order height
+correction of normal gravity stays within 2 % of the inverse-square law there, and is wrong
+beyond), Euler angles within ±360°.
 
 Output: one row per update, ``t,lat_deg,lon_deg,height_m,vn,ve,vd,qw,qx,qy,qz`` (NED,
 ``q_n_b``), CSV or ``.npz``; the navigation runs in chunks through
@@ -65,7 +71,8 @@ from strapdown.io.readers import (
 from strapdown.rotation.dcm import quat_from_dcm
 from strapdown.rotation.euler import dcm_from_euler_zyx
 
-__all__ = ["ACC_UNITS", "NAV_COLUMNS", "AccUnit", "NavLog", "increments_from_rates",
+__all__ = ["ACC_UNITS", "HEIGHT_RANGE_M", "MAX_ANGLE_DEG", "MAX_LONGITUDE_DEG",
+           "MAX_SPECIFIC_FORCE", "NAV_COLUMNS", "AccUnit", "NavLog", "increments_from_rates",
            "navigate_log", "read_nav_log"]
 
 #: Accelerometer units: specific force (m/s², g) for rate logs, velocity increments (m/s).
@@ -77,6 +84,15 @@ _ACC_ALLOWED: dict[InputKind, tuple[AccUnit, ...]] = {"rate": ("m/s2", "g"),
 NAV_COLUMNS = ("t", "lat_deg", "lon_deg", "height_m", "vn", "ve", "vd", "qw", "qx", "qy", "qz")
 G0 = 9.80665
 CHUNK = 1 << 15
+#: Largest specific force accepted (m/s², about 10⁶ g: beyond any accelerometer's range,
+#: shock-hardened ones included); more is a unit or a file error.
+MAX_SPECIFIC_FORCE = 1e7
+#: Initial heights accepted (m above the WGS-84 ellipsoid; see the module docstring).
+HEIGHT_RANGE_M = (-2.0e4, 1.0e6)
+#: Largest initial longitude magnitude (deg): −180…180° and 0…360° both accepted.
+MAX_LONGITUDE_DEG = 360.0
+#: Largest initial Euler angle magnitude (deg).
+MAX_ANGLE_DEG = 360.0
 
 
 @dataclass(frozen=True)
@@ -185,6 +201,23 @@ def _check_acc_magnitude(path: Path, f: NDArray[np.float64], unit: str,
     warnings.warn(msg, UnitWarning, stacklevel=3)
 
 
+def _check_acc_range(path: Path, acc: NDArray[np.float64], unit: str, h: float) -> None:
+    """Refuse a sample whose specific force (increments: over their interval ``h``) exceeds
+    :data:`MAX_SPECIFIC_FORCE`, naming its data row (no overflow on the way)."""
+    scale = {"g": G0, "m/s2": 1.0, "m/s": 1.0 / h}[unit]
+    a = np.abs(acc)
+    norm = np.hypot(np.hypot(a[:, 0], a[:, 1]), a[:, 2])  # finite up to 1.7e308
+    with np.errstate(over="ignore"):
+        bad = ~(norm * scale <= MAX_SPECIFIC_FORCE)
+    if np.any(bad):
+        i = int(np.argmax(bad))
+        what = "specific force" if unit != "m/s" else "velocity increment"
+        over = f" over its {h:.3g} s interval" if unit == "m/s" else ""
+        raise InputError(f"{path}: data row {i + 1}: accelerometer {what} of {norm[i]:.4g} "
+                         f"{unit}{over} exceeds {MAX_SPECIFIC_FORCE:.0e} m/s² (about 10⁶ g); "
+                         "check the accelerometer units and the file")
+
+
 def _uniform_period(path: Path, t: NDArray[np.float64], nominal: float | None) -> float:
     """The sample period; stamps straying over :data:`JITTER_TOLERANCE` periods from the
     uniform grid are an error (the navigation needs a fixed interval)."""
@@ -226,16 +259,18 @@ def read_nav_log(path: str | os.PathLike[str], *, kind: InputKind = "rate",
     if path.suffix.lower() == ".npy":
         raise InputError(f"{path}: .npy logs hold a gyro only; a nav log is .csv, .npz, "
                          ".h5/.hdf5 or .mat")
-    log = read_imu(path, kind=kind, units=units,
-                   columns=None if columns is None else list(columns[:4]),
-                   sample_rate_hz=sample_rate_hz, on_gap="error", unit_check=unit_check)
-    acc, stated = _accel_source(path, columns)
+    with np.errstate(over="ignore", invalid="ignore"):  # values beyond float64 (a float128
+        log = read_imu(path, kind=kind, units=units,  # file) read as infinity, refused
+                       columns=None if columns is None else list(columns[:4]),  # by row
+                       sample_rate_hz=sample_rate_hz, on_gap="error", unit_check=unit_check)
+        acc, stated = _accel_source(path, columns)
     if acc.ndim != 2 or acc.shape != log.data.shape:
         raise InputError(f"{path}: {log.data.shape[0]} gyro samples but accelerometer values of "
                          f"shape {acc.shape}")
     check_rows(path, log.t, [("accelerometer", [acc])])
     unit = _acc_unit(path, kind, acc_units, stated)
     h = _uniform_period(path, log.t, log.nominal_period)
+    _check_acc_range(path, acc, unit, h)
     _check_acc_magnitude(path, acc if kind == "rate" else acc / h, unit, unit_check)
     si = acc * G0 if unit == "g" else acc
     return NavLog(log.t, log.data, np.ascontiguousarray(si), kind, h, log.units, unit)
@@ -272,6 +307,13 @@ def _initial_state(lat_deg: float, lon_deg: float, height: float,
             raise InputError(f"initial {name} must be finite, got {c}")
     if not abs(lat_deg) < 90.0:
         raise InputError(f"initial latitude must lie within ±90°, got {lat_deg}°")
+    if not abs(lon_deg) <= MAX_LONGITUDE_DEG:
+        raise InputError(f"initial longitude must lie within ±{MAX_LONGITUDE_DEG:g}° "
+                         f"(−180…180° or 0…360°), got {lon_deg:g}°")
+    lo, hi = HEIGHT_RANGE_M
+    if not lo <= height <= hi:
+        raise InputError(f"initial height must lie within {lo:g}…{hi:g} m above the WGS-84 "
+                         f"ellipsoid (the normal gravity model's range), got {height:g} m")
     v = np.zeros(3) if velocity is None else np.asarray(velocity, dtype=np.float64)
     ypr = np.zeros(3) if attitude_deg is None else np.asarray(attitude_deg, dtype=np.float64)
     for name, x in (("velocity (VN VE VD)", v), ("attitude (YAW PITCH ROLL)", ypr)):
@@ -279,6 +321,9 @@ def _initial_state(lat_deg: float, lon_deg: float, height: float,
             raise InputError(f"initial {name} needs three values, got {x.size}")
         if not np.all(np.isfinite(x)):
             raise InputError(f"initial {name} must be finite, got {x.tolist()}")
+    if not np.all(np.abs(ypr) <= MAX_ANGLE_DEG):
+        raise InputError(f"initial attitude (YAW PITCH ROLL) angles must lie within "
+                         f"±{MAX_ANGLE_DEG:g}°, got {ypr.tolist()}")
     q = quat_from_dcm(dcm_from_euler_zyx(*np.radians(ypr)))
     return math.radians(lat_deg), math.radians(lon_deg), float(height), v, q
 
