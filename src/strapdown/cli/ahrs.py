@@ -6,7 +6,10 @@ import argparse
 
 from strapdown.cli._common import columns, input_args, log_check_args, say
 
-__all__ = ["add_parser", "run"]
+__all__ = ["MAX_DECLINATION_DEG", "add_parser", "run"]
+
+#: Largest magnetic declination magnitude accepted (deg).
+MAX_DECLINATION_DEG = 180.0
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
@@ -60,15 +63,19 @@ def _arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--no-gating", action="store_true",
                    help="accept every measurement (no innovation gating or disturbance checks)")
     p.add_argument("--declination-deg", type=float, default=0.0,
-                   help="magnetic declination (deg, east positive); 0 gives a magnetic-north "
-                   "heading")
+                   help="magnetic declination (deg, east positive, within ±180); 0 gives a "
+                   "magnetic-north heading")
 
 
 def run(args: argparse.Namespace) -> int:
     """Filter the recording, write attitude and metadata, report what was used."""
+    from strapdown._core.errors import InputError
     from strapdown.ahrs import AhrsConfig
     from strapdown.apps.ahrs_log import run_ahrs
 
+    if not abs(args.declination_deg) <= MAX_DECLINATION_DEG:
+        raise InputError(f"--declination-deg must lie within ±{MAX_DECLINATION_DEG:g}° (east "
+                         f"positive), got {args.declination_deg:g}")
     cfg = AhrsConfig(gating=not args.no_gating, declination_deg=args.declination_deg,
                      gyro_sample=args.gyro_sample)
     res, meta = run_ahrs(args.imu, args.out, algorithm=args.algorithm, frame=args.frame,
