@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from strapdown._core.errors import InputError, shown
 from strapdown._core.validation import positive
 from strapdown.algorithms.coning import MAX_SUBSAMPLES
 from strapdown.algorithms.family import InputKind
@@ -39,10 +40,10 @@ from strapdown.analysis.spectrum import (
 from strapdown.io.readers import ImuLog
 from strapdown.rotation.error import attitude_error_vector
 
-__all__ = ["NEGLIGIBLE_DEG_H", "NEGLIGIBLE_FRACTION", "PSD_COLUMNS", "Advice", "Candidate",
-           "Reference", "advise", "candidate_specs", "coning_content", "log_reference",
-           "log_spectrum", "read_psd", "unresolved_fraction", "verified_drift_deg_h",
-           "write_figure"]
+__all__ = ["NEGLIGIBLE_DEG_H", "NEGLIGIBLE_FRACTION", "PSD_COLUMNS", "SPECTRUM_MIN_SAMPLES",
+           "VERIFY_MIN_SAMPLES", "Advice", "Candidate", "Reference", "advise",
+           "candidate_specs", "coning_content", "log_reference", "log_spectrum", "read_psd",
+           "unresolved_fraction", "verified_drift_deg_h", "write_figure"]
 
 #: Columns of a ``--psd`` CSV: frequency (Hz) and the imaginary parts of the one-sided
 #: cross-spectral densities G_yz, G_zx, G_xy (rad²/s²/Hz, scipy's conj(X) Y convention).
@@ -70,6 +71,8 @@ REFERENCE_UPSAMPLE = 16
 _REFERENCE_SPEC = "rotvec:N=6:structure=single-chain"
 #: Fraction of the log at either end left out of a verified drift (the FFT's periodic wrap).
 EDGE_FRACTION = 0.1
+#: Fewest samples a log's spectrum (Welch) needs, and the fewest the verification needs.
+SPECTRUM_MIN_SAMPLES, VERIFY_MIN_SAMPLES = 16, 64
 
 
 @dataclass(frozen=True)
@@ -128,8 +131,9 @@ def log_reference(log: ImuLog, *, upsample: int = REFERENCE_UPSAMPLE) -> Referen
     if upsample < 4 or upsample % 2:
         raise ValueError(f"upsample must be an even number ≥ 4, got {upsample}")
     n = log.data.shape[0]
-    if n < 64:
-        raise ValueError(f"verifying on the log needs at least 64 samples, got {n} (--no-verify)")
+    if n < VERIFY_MIN_SAMPLES:
+        raise InputError(f"verifying on the log needs at least {VERIFY_MIN_SAMPLES} samples, "
+                         f"got {n} (--no-verify)")
     t = np.arange(n + 1) * log.h
     window = (float(t[round(EDGE_FRACTION * n)]), float(t[round((1 - EDGE_FRACTION) * n)]))
     q = _reference_attitude(log, upsample)
@@ -245,28 +249,78 @@ def unresolved_fraction(log: ImuLog, f: NDArray[np.float64], g: NDArray[np.compl
     return float(np.clip(np.max(share), 0.0, 1.0))
 
 
-def read_psd(path: str | Path) -> tuple[NDArray[np.float64], NDArray[np.complex128]]:
-    """A ``--psd`` CSV (:data:`PSD_COLUMNS`, uniform increasing frequencies) as CSDs (F, 3, 3)
-    holding the imaginary parts (the real parts do not drift an algorithm)."""
-    with open(path, newline="", encoding="utf-8") as fh:
-        rows = list(csv.reader(fh))
-    if not rows or tuple(c.strip() for c in rows[0]) != PSD_COLUMNS:
-        raise ValueError(f"{path}: a PSD file needs the header {','.join(PSD_COLUMNS)}")
+def read_psd(path: str | Path, sample_rate_hz: float | None = None
+             ) -> tuple[NDArray[np.float64], NDArray[np.complex128]]:
+    """A ``--psd`` CSV (:data:`PSD_COLUMNS`, uniform increasing frequencies from 0 Hz up) as
+    CSDs (F, 3, 3) holding the imaginary parts (the real parts do not drift an algorithm).
+
+    With ``sample_rate_hz`` a column whose coning power (``Σ |value| Δf``, rad²/s²) exceeds
+    ``(π · sample_rate_hz)²`` — rates turning the body by more than π per sample, beyond
+    Nyquist like a log's (:data:`strapdown.io.readers.MAX_SAMPLE_ANGLE`) — is refused at the
+    row where it does. Anything wrong with the file is an :class:`~strapdown.InputError`
+    naming it (and the row, where there is one).
+    """
+    from strapdown.io.readers import input_file
+
+    path = input_file(path, "PSD file")
+    raw = path.read_bytes()
     try:
-        vals = np.array([[float(x) for x in r] for r in rows[1:] if r], dtype=np.float64)
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        line = raw.count(b"\n", 0, exc.start)
+        where = "the header row" if line == 0 else f"data row {line}"
+        bad = shown(raw[exc.start:exc.start + 8], 40)
+        raise InputError(f"{path}: not UTF-8 text (bytes {bad} in {where}); expected a PSD "
+                         "CSV") from None
+    try:
+        rows = list(csv.reader(text.splitlines()))
+    except csv.Error as exc:
+        raise InputError(f"{path}: unreadable CSV ({shown(str(exc), 120)})") from None
+    if not rows or tuple(c.strip() for c in rows[0]) != PSD_COLUMNS:
+        raise InputError(f"{path}: a PSD file needs the header {','.join(PSD_COLUMNS)}")
+    data = [(r, row) for r, row in enumerate(rows[1:], start=1) if row]
+    for r, row in data:
+        if len(row) != 4:
+            raise InputError(f"{path}: data row {r} has {len(row)} fields; need four values")
+    try:
+        vals = np.array([[float(x) for x in row] for _, row in data], dtype=np.float64)
     except ValueError:
-        raise ValueError(f"{path}: every PSD value must be a number") from None
-    if vals.ndim != 2 or vals.shape[0] < 2 or vals.shape[1] != 4 or not np.all(
-            np.isfinite(vals)):
-        raise ValueError(f"{path}: need at least two finite rows of four values")
-    df = np.diff(vals[:, 0])
+        raise InputError(f"{path}: every PSD value must be a number") from None
+    if vals.shape[0] < 2:
+        raise InputError(f"{path}: need at least two rows of four values, got {vals.shape[0]}")
+    bad = ~np.all(np.isfinite(vals), axis=1)
+    if np.any(bad):
+        raise InputError(f"{path}: NaN or infinity in data row {data[int(np.argmax(bad))][0]}")
+    f = vals[:, 0]
+    if f[0] < 0:
+        raise InputError(f"{path}: f_hz must not be negative, got {f[0]:g} in data row 1")
+    df = np.diff(f)  # no overflow: finite and (below) non-negative increasing
     if np.any(df <= 0) or np.ptp(df) > 1e-6 * df.mean():
-        raise ValueError(f"{path}: f_hz must increase in uniform steps")
+        raise InputError(f"{path}: f_hz must increase in uniform steps")
+    if sample_rate_hz is not None:
+        _check_psd_power(path, vals, float(df.mean()), sample_rate_hz, data)
     g = np.zeros((vals.shape[0], 3, 3), dtype=np.complex128)
     for col, (i, j) in enumerate(PAIRS, start=1):
         g[:, i, j] = 1j * vals[:, col]
         g[:, j, i] = -1j * vals[:, col]
-    return vals[:, 0], g
+    return f, g
+
+
+def _check_psd_power(path: Path, vals: NDArray[np.float64], df: float, fs: float,
+                     data: list) -> None:
+    """Refuse a column of a PSD file whose coning power exceeds ``(π fs)²`` (see
+    :func:`read_psd`), at the data row where its running sum does."""
+    limit = (math.pi * fs) ** 2
+    with np.errstate(over="ignore"):
+        power = np.cumsum(np.abs(vals[:, 1:]), axis=0) * df
+    over = ~(power <= limit)
+    if np.any(over):
+        k, col = divmod(int(np.argmax(over.ravel())), 3)
+        raise InputError(f"{path}: data row {data[k][0]} ({PSD_COLUMNS[col + 1]} = "
+                         f"{vals[k, col + 1]:.3g}): the column's coning power Σ |value| Δf "
+                         f"exceeds (π × {fs:g} Hz)² = {limit:.3g} rad²/s² there, rates turning "
+                         "the body by more than π per sample; check the units (rad²/s²/Hz) "
+                         "and --sample-rate-hz")
 
 
 def coning_content(predicted: float, stderr: float, measured: float | None, level: float, *,
@@ -325,7 +379,11 @@ def advise(f: NDArray[np.float64], g: NDArray[np.complex128], h: float,
         raise ValueError(f"--verify must be ≥ 0, got {verify}")
     cands = []
     for spec in specs:
-        d = float(np.linalg.norm(predict_drift(spec, f, g, h))) * _RAD_S_TO_DEG_H
+        with np.errstate(over="ignore", invalid="ignore"):  # refused below
+            d = float(np.linalg.norm(predict_drift(spec, f, g, h))) * _RAD_S_TO_DEG_H
+        if not math.isfinite(d):
+            raise InputError(f"the drift predicted for {spec} overflows: the spectrum's coning "
+                             "power is too large (check its units: rad²/s²/Hz)")
         cands.append(Candidate(spec, d, float(cost(spec, h))))
     cands.sort(key=lambda c: (c.predicted_drift_deg_h, c.ops_per_s))
     pool = [c for c in cands if max_ops is None or c.ops_per_s <= max_ops]

@@ -67,14 +67,24 @@ def _ops_per_s(spec, h: float) -> float:
 
 def _spectrum(args: argparse.Namespace):
     """(frequencies, CSDs, h, Welch segments or None, input kind or None, log or None)."""
-    from strapdown.apps.advise import log_spectrum, read_psd
+    import numpy as np
 
+    from strapdown._core.errors import InputError
+    from strapdown.apps.advise import (
+        SPECTRUM_MIN_SAMPLES,
+        VERIFY_MIN_SAMPLES,
+        log_spectrum,
+        read_psd,
+    )
+
+    if args.verify < 0:
+        raise InputError(f"--verify must be ≥ 0, got {args.verify}")
     if (args.imu is None) == (args.psd is None):
         raise ValueError("give one of --imu LOG or --psd FILE")
     if args.psd is not None:
         if args.sample_rate_hz is None or not args.sample_rate_hz > 0:
             raise ValueError("--psd needs --sample-rate-hz (the rate the algorithm runs at)")
-        f, g = read_psd(args.psd)
+        f, g = read_psd(args.psd, sample_rate_hz=args.sample_rate_hz)
         return f, g, 1.0 / args.sample_rate_hz, None, None, None
     if args.kind is None:
         raise ValueError("--imu needs --rates or --increments")
@@ -83,8 +93,17 @@ def _spectrum(args: argparse.Namespace):
     from strapdown.io import read_imu
 
     cols = None if args.columns is None else columns(args.columns)
-    log = read_imu(args.imu, kind=args.kind, units=args.units, columns=cols,
-                   sample_rate_hz=args.sample_rate_hz, delimiter=args.delimiter)
+    with np.errstate(over="ignore", invalid="ignore"):  # values beyond float64 (a float128
+        log = read_imu(args.imu, kind=args.kind, units=args.units,  # .npy) read as
+                       columns=cols, sample_rate_hz=args.sample_rate_hz,  # infinity and are
+                       delimiter=args.delimiter)  # refused with their row
+    n = log.data.shape[0]
+    need = VERIFY_MIN_SAMPLES if args.verify > 0 else SPECTRUM_MIN_SAMPLES
+    if n < need:
+        raise InputError(f"{args.imu}: {n} samples; " + (
+            f"verifying on the log needs at least {need} (--no-verify ranks by the spectrum "
+            f"alone, which needs {SPECTRUM_MIN_SAMPLES})" if args.verify > 0
+            else f"a spectrum needs at least {need}"))
     f, g, segments = log_spectrum(log, nperseg=args.nperseg)
     return f, g, log.h, segments, log.kind, log
 
@@ -101,8 +120,6 @@ def run(args: argparse.Namespace) -> int:
     )
 
     f, g, h, segments, kind, log = _spectrum(args)
-    if args.verify < 0:
-        raise ValueError(f"--verify must be ≥ 0, got {args.verify}")
     ref = log_reference(log) if log is not None and args.verify > 0 else None
     measure = None if ref is None else (lambda spec: verified_drift_deg_h(spec, log, ref))
     adv = advise(f, g, h, candidate_specs(kind), _ops_per_s, budget_deg_h=args.budget_deg_h,
