@@ -363,6 +363,7 @@ def cases(scn: Scenario) -> list[Case]:
                 cfg = EvaluationConfig(**{**cfg_fields, **parse_spec(a)}, gyro=errors, seed=seed)
                 cfg.validate()
                 _ = cfg.samples
+                _check_runs(cfg)
                 _check_metrics(cfg, scn.metrics)
             except (ValueError, TypeError, OverflowError, ArithmeticError) as exc:
                 raise InputError(f"case {len(out)} ({a}, {shown(params, 120)}): {exc}"
@@ -371,6 +372,41 @@ def cases(scn: Scenario) -> list[Case]:
     if not out:
         raise InputError("the grid is empty")
     return out
+
+
+#: Largest relative gyro scale-factor error and misalignment entry a scenario may set
+#: (100 %: beyond, the sensor measures another motion, not the one configured).
+MAX_RELATIVE_ERROR = 1.0
+
+
+def _check_runs(cfg: EvaluationConfig) -> None:
+    """What :meth:`EvaluationConfig.validate` leaves to run time, so that a scenario that
+    validates also runs: the motion is built (pure spin needs a spin rate), and each gyro
+    error stays within what the samples resolve — a bias, Gauss–Markov σ and white noise
+    per sample (``σ·√h``) turning the body by at most π per sample (Nyquist, as the motion
+    rates), scale factors and misalignments within ±:data:`MAX_RELATIVE_ERROR`."""
+    if cfg.motion == "spin" and cfg.spin_rate_dps == 0:
+        raise InputError("pure spin needs a non-zero spin_rate_dps")
+    if cfg.motion != "sculling":
+        from strapdown.analysis.evaluate import build_motion
+
+        build_motion(cfg)
+    e = cfg.gyro
+    if e is None:
+        return
+    h = cfg.h
+    turns = {"bias": float(np.max(np.abs(e.bias))) * h,
+             "gm_sigma": float(np.max(e.gm_sigma)) * h,
+             "white_noise": float(e.white_noise) * math.sqrt(h)}
+    for name, angle in turns.items():
+        if not angle <= math.pi:
+            raise InputError(f"gyro {name} turns the body by {angle:.3g} rad per sample at "
+                             f"{cfg.sample_rate_hz:g} Hz; at most π (Nyquist)")
+    for name in ("scale_factor", "misalignment"):
+        big = float(np.max(np.abs(getattr(e, name))))
+        if not big <= MAX_RELATIVE_ERROR:
+            raise InputError(f"gyro {name} must lie within ±{MAX_RELATIVE_ERROR:g} (relative), "
+                             f"got {big:g}")
 
 
 def _check_metrics(cfg: EvaluationConfig, metrics: Iterable[str]) -> None:
@@ -495,19 +531,41 @@ def sweep(scenario: str | os.PathLike[str] | Scenario, out: str | os.PathLike[st
     SweepInterrupted
         On Ctrl-C (a ``KeyboardInterrupt``), after stopping the workers; it says how many
         cases are saved.
+
+    Whatever stops a sweep, the directories it created and left empty (``out/cases`` before
+    the first finished case) are removed again.
     """
     kind, address = _parse_scheduler(scheduler)
     formats = _check_options(tuple(formats), workers, max_cases)
     scn = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
-    say = log or (lambda _m: None)
     out = Path(out)
     if out.exists() and not out.is_dir():
         raise InputError(f"{out} exists and is not a directory")
+    all_cases = cases(scn)
     store = out / "cases"
+    made, d = [], store  # the directories this call creates: removed again if left empty
+    while not d.exists() and d != d.parent:
+        made.append(d)
+        d = d.parent
     store.mkdir(parents=True, exist_ok=True)
+    try:
+        return _sweep(scn, out, store, all_cases, kind, address, workers, formats,
+                      max_cases, progress, log or (lambda _m: None))
+    except BaseException:
+        for d in made:  # deepest first: a failed first run leaves no empty directories
+            try:
+                d.rmdir()
+            except OSError:  # not empty (a finished case) or already gone: kept
+                break
+        raise
+
+
+def _sweep(scn: Scenario, out: Path, store: Path, all_cases: list[Case], kind: str,
+           address: str | None, workers: int | None, formats: tuple, max_cases: int | None,
+           progress: bool, say: Callable[[str], None]) -> SweepResult:
+    """:func:`sweep` once the scenario is checked and ``store`` exists."""
     for stale in store.glob(".*.json.*"):  # temp files of a killed run (never a finished case)
         stale.unlink(missing_ok=True)
-    all_cases = cases(scn)
     first = {c.key: c for c in reversed(all_cases)}  # each configuration's first case
     stored = {k for k in first if (store / f"{k}.json").is_file()}
     pending = [first[k] for k in dict.fromkeys(c.key for c in all_cases) if k not in stored]
