@@ -51,14 +51,17 @@ def _arguments(p: argparse.ArgumentParser) -> None:
                    help="run although magnitudes suggest other units than declared")
     input_args(g, delimiter=False)
     s = p.add_argument_group("initial state")
-    s.add_argument("--init-lat", type=float, required=True, help="latitude (deg)")
-    s.add_argument("--init-lon", type=float, required=True, help="longitude (deg)")
+    s.add_argument("--init-lat", type=float, required=True, help="latitude (deg, within ±90)")
+    s.add_argument("--init-lon", type=float, required=True,
+                   help="longitude (deg, within ±360: -180..180 or 0..360)")
     s.add_argument("--init-height", type=float, required=True,
-                   help="height above the WGS-84 ellipsoid (m)")
+                   help="height above the WGS-84 ellipsoid (m, -20000..1000000: the range of "
+                   "the normal gravity model)")
     s.add_argument("--init-velocity", type=float, nargs=3, metavar=("VN", "VE", "VD"),
                    default=None, help="NED velocity (m/s; default at rest)")
     s.add_argument("--init-attitude", type=float, nargs=3, metavar=("YAW", "PITCH", "ROLL"),
-                   default=None, help="z-y-x Euler angles of the body in NED (deg; default 0 0 0)")
+                   default=None, help="z-y-x Euler angles of the body in NED (deg, each within "
+                   "±360; default 0 0 0)")
     a = p.add_argument_group("algorithm")
     a.add_argument("--structure", choices=NAV_STRUCTURES, default="conventional",
                    help="conventional: an update every N samples; single-chain: every sample")
