@@ -383,8 +383,8 @@ def _check_time_base(path: Path, t_ref: NDArray[np.float64], log,
     for unit, s in _TIME_SLIPS:
         if (_covered(s * t0, s * t1, lo, hi) >= 0.5
                 and abs(math.log(s * period / log.h)) < abs(math.log(period / log.h))):
-            declare = ("declare it in the header (t[" + unit + "]) or write the times in "
-                       "seconds" if path.suffix.lower() in (".csv", ".txt", ".tsv")
+            declare = (f"declare it in the header (t[{unit}]; t[s] if it is seconds)"
+                       if path.suffix.lower() in (".csv", ".txt", ".tsv")
                        else "write its t in seconds")
             raise InputError(
                 f"{path}: truth times {t0:.6g}…{t1:.6g} (period {period:.3g}) do not fit the "
