@@ -188,7 +188,8 @@ def test_run_split_at_gap_restarts_integration(tmp_path):
     angle = 2 * np.arctan2(a["qx"][-1], a["qw"][-1])
     assert angle == pytest.approx(0.18, rel=1e-12)
     # without splitting, rate algorithms refuse the gap and write nothing
-    with pytest.raises(ValueError, match=r"1 gap\(s\), the first of 0\.11 s before data row 11; "
+    with pytest.raises(ValueError, match=r"1 gap\(s\) \(10 sample\(s\) missing on the fitted "
+                       r"100 Hz clock\), the first of 0\.11 s before data row 11; "
                        "rate algorithms cannot bridge a gap: pass --on-gap split"):
         run_log(tmp_path / "log.csv", tmp_path / "b.csv", kind="rate", units="rad/s",
                 algorithm="rate-single")

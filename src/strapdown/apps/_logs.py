@@ -23,9 +23,15 @@ import numpy as np
 from numpy.typing import NDArray
 
 from strapdown._core.errors import InputError
-from strapdown.algorithms.rate import UNIFORM_TOLERANCE, RateRecord, check_rate_record
+from strapdown.algorithms.rate import (
+    UNIFORM_TOLERANCE,
+    RateRecord,
+    check_rate_record,
+    resample_uniform,
+)
 from strapdown.io.files import atomic_path
 from strapdown.io.readers import ImuLog, UnitAction
+from strapdown.io.timing import Timing
 
 __all__ = ["JitterSummary", "PairedOutput", "check_finite", "log_segments",
            "output_with_sidecar", "rate_records", "sidecar_path", "unit_action"]
@@ -44,17 +50,40 @@ class JitterSummary:
     jitter: float  # largest deviation of a stamp from its segment's grid, in periods
     resampled: bool
     segments: int
+    timing: Timing | None = None
 
     def describe(self) -> str:
-        """``nominal period 0.001 s (1000 Hz), jitter ±0.5 % of it`` (+ resampled)."""
+        """The clock and rows (:meth:`strapdown.io.timing.Timing.describe`), else
+        ``nominal period 0.001 s (1000 Hz), jitter ±0.5 % of it`` (+ resampled)."""
+        if self.timing is not None and self.timing.clock is not None:
+            text = self.timing.describe()
+            if self.resampled and "resampled" not in text:
+                text += "; resampled onto the uniform grid"
+            return text
         text = f"nominal period {self.period:.6g} s ({1 / self.period:.6g} Hz), "
         text += (f"jitter ±{100 * self.jitter:.2g} % of it" if self.jitter > UNIFORM_TOLERANCE
                  else "uniform time stamps")
         return text + (", resampled onto the uniform grid" if self.resampled else "")
 
     def to_dict(self) -> dict[str, Any]:
-        return {"sample_period_s": self.period, "jitter_periods": self.jitter,
-                "resampled": self.resampled, "segments": self.segments}
+        out: dict[str, Any] = {"sample_period_s": self.period, "jitter_periods": self.jitter,
+               "resampled": self.resampled, "segments": self.segments}
+        if self.timing is not None:
+            out["timing"] = self.timing.to_dict()
+        return out
+
+
+def _gap_error(path: Path, log: ImuLog, remedy: str) -> InputError:
+    """The refusal of a log with gaps, naming the first and what gets past it."""
+    r = log.gaps[0]
+    i = log.index_of_row(r)
+    gap = float(log.t[i] - log.t[i - 1])
+    on_clock = log.timing is not None and log.timing.on_clock
+    what = (f"{log.timing.clock.missing} sample(s) missing on the fitted "
+            f"{1 / log.h:.6g} Hz clock" if on_clock and log.timing and log.timing.clock
+            else "interval(s) over the gap tolerance")
+    return InputError(f"{path}: {len(log.gaps)} gap(s) ({what}), the first of {gap:.6g} s "
+                      f"before data row {r}; {remedy}")
 
 
 def rate_records(path: Path, log: ImuLog, *, split: bool, min_samples: int,
@@ -62,28 +91,70 @@ def rate_records(path: Path, log: ImuLog, *, split: bool, min_samples: int,
     """The log's rates on a uniform grid, one record per gap-free segment (``split``) or
     one for the whole log, and their time base.
 
-    Gaps in an unsplit log are an error (rate algorithms cannot bridge one); so are
-    stamps beyond the jitter tolerance (:func:`strapdown.algorithms.rate.check_rate_record`,
-    which also takes the nominal period from ``--sample-rate-hz``).
+    How the stamps are taken is the log's :class:`~strapdown.io.timing.Timing` (``resample``
+    forces ``resample``): on the fitted sensor clock (``auto`` unless the sampling is
+    irregular, ``nominal``) the samples are taken at ``c + p·k`` of their ticks — the grid
+    is uniform, and a gap is whole missing periods; ``stamps`` requires uniform stamps;
+    ``resample`` (and ``auto`` on irregular sampling) interpolates the rates onto a uniform
+    grid (:func:`strapdown.algorithms.rate.resample_uniform`, a cubic spline: its error is
+    fourth order in the period). Gaps in an unsplit log are an error (rate algorithms
+    cannot bridge one).
     """
+    timing = log.timing
+    mode = "resample" if resample else (timing.mode if timing is not None else "stamps")
     if log.gaps and not split:
-        r = log.gaps[0]
-        gap = float(log.t[r - 1] - log.t[r - 2])
-        raise InputError(f"{path}: {len(log.gaps)} gap(s), the first of {gap:.6g} s before data "
-                         f"row {r}; rate algorithms cannot bridge a gap: pass --on-gap split "
-                         "(each gap-free segment on its own) or --on-gap error")
+        raise _gap_error(path, log, "rate algorithms cannot bridge a gap: pass --on-gap split "
+                         "(each gap-free segment on its own, from the previous one's last "
+                         "attitude)")
     cuts = log.segments() if split else [slice(0, log.t.size)]
     recs = []
     for k, c in enumerate(cuts):
+        where = f" segment {k} (data rows {_row(log, c.start)}-{_row(log, c.stop - 1)})" \
+            if split else ""
         try:
-            recs.append(check_rate_record(log.t[c], log.data[c], min_samples=min_samples,
-                                          td=log.nominal_period, resample=resample))
+            recs.append(_record(log, c, mode, min_samples))
         except ValueError as exc:
-            where = f" segment {k} (data rows {c.start + 1}-{c.stop})" if split else ""
             raise InputError(f"{path}:{where} {exc}") from None
     longest = max(recs, key=lambda r: r.t.size)
     return recs, JitterSummary(longest.td, max(r.jitter for r in recs),
-                               any(r.resampled for r in recs), len(recs))
+                               any(r.resampled for r in recs), len(recs), timing)
+
+
+def _row(log: ImuLog, i: int) -> int:
+    return int(log.timing.rows[i]) if log.timing is not None else i + 1
+
+
+def _record(log: ImuLog, c: slice, mode: str, min_samples: int) -> RateRecord:
+    """One segment's :class:`RateRecord` under the timing ``mode`` (see rate_records)."""
+    timing = log.timing
+    t, w = log.t[c], log.data[c]
+    clock = None if timing is None else timing.clock
+    if timing is None or clock is None or mode == "stamps":
+        if clock is not None and clock.kind != "uniform":
+            raise ValueError(
+                f"the time stamps are not uniform ({clock.describe()}); rate algorithms need "
+                "uniform samples: --timing auto or nominal (the samples on the sensor's "
+                "clock) or --timing resample (interpolated at the stamps)")
+        return check_rate_record(t, w, min_samples=min_samples, td=log.nominal_period)
+    if t.size < min_samples:
+        raise ValueError(f"the record has {t.size} samples; this algorithm needs at least "
+                         f"{min_samples}")
+    base = float(log.t[0])
+    if mode == "resample" or not timing.on_clock:
+        p = clock.period if clock.kind != "irregular" else float(np.median(np.diff(t)))
+        m = int(np.floor((t[-1] - t[0]) / p * (1 + 1e-12))) + 1
+        if m < min_samples:
+            raise ValueError(f"the resampled record has {m} samples; this algorithm needs at "
+                             f"least {min_samples}")
+        grid = t[0] + np.arange(m) * p
+        return RateRecord(grid, resample_uniform(t, w, grid), p, stamps=t, resampled=True,
+                          measured_jitter=clock.residual_max / clock.period)
+    ticks = clock.ticks[c]
+    if clock.kind == "uniform" and log.nominal_period is None:
+        return RateRecord(t, w, clock.period, measured_jitter=0.0)
+    grid = base + (clock.uniform_times(ticks) - clock.uniform_times(clock.ticks[:1])[0])
+    return RateRecord(grid, w, clock.period, stamps=t,
+                      measured_jitter=clock.residual_max / clock.period)
 
 
 def log_segments(path: Path, log: ImuLog, *, split: bool, min_samples: int,

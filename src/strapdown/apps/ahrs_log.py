@@ -42,26 +42,40 @@ import numpy as np
 from strapdown._core.errors import InputError, shown
 from strapdown.ahrs import AhrsConfig, AhrsResult, MeasurementFlag, ekf, offline_ekf
 from strapdown.algorithms.rate import resample_uniform
-from strapdown.apps._logs import output_with_sidecar, rate_records, unit_action
+from strapdown.apps._logs import JitterSummary, output_with_sidecar, rate_records, unit_action
 from strapdown.io import (
     UnitWarning,
-    check_rows,
     csv_columns,
     warn_implausible_rate,
     write_attitude,
 )
 from strapdown.io.readers import (
     ACC_COLUMNS,
+    EPOCH_LIKE_S,
     GYRO_COLUMNS,
     MAG_COLUMNS,
     ImuLog,
     UnitAction,
+    check_distinct_columns,
+    check_finite_rows,
     check_motion,
     check_read_options,
+    check_stamp_steps,
     default_columns,
     input_file,
     time_scale,
 )
+from strapdown.io.timing import (
+    JITTER_TOLERANCE,
+    DuplicatePolicy,
+    HeldPolicy,
+    Timing,
+    TimingMode,
+    reconstruct,
+    relative_times,
+)
+from strapdown.rotation.dcm import dcm_from_quat
+from strapdown.rotation.euler import euler_zyx_from_dcm
 
 __all__ = ["ACC_LIMIT", "ACC_UNITS", "BIAS_LIMIT", "DEFAULT_COLUMNS", "GYRO_UNITS", "MAG_LIMIT",
            "AhrsLog", "read_ahrs_log", "run_ahrs"]
@@ -91,6 +105,8 @@ class AhrsLog:
     acc_units: str = "m/s2"
     gaps: list[int] = field(default_factory=list)
     nominal_period: float | None = None
+    timing: Timing | None = None
+    inferred: dict[str, str] = field(default_factory=dict)
 
 
 def _unit(path: Path, what: str, option: str, allowed, declared, found, whose) -> str:
@@ -120,7 +136,8 @@ def _csv(path: Path, columns, delimiter: str | None):
         columns = axes + mag
     elif len(columns) not in (7, 10):
         raise InputError(f"columns must name t, 3 gyro, 3 accelerometer and optionally 3 "
-                         f"magnetometer columns, got {len(columns)}")
+                         f"magnetometer columns (names or 0-based indices), got {len(columns)}")
+    check_distinct_columns(columns)
     raw, units, have_mag = csv_columns(path, list(columns[:7]), optional=list(columns[7:10]),
                                        delimiter=delimiter)
     found = {}
@@ -130,12 +147,13 @@ def _csv(path: Path, columns, delimiter: str | None):
             raise InputError(f"{path}: the header gives the {what} axes different units "
                              f"{sorted(us)}")
         found[what] = us.pop() if us else None
-    t = raw[:, 0] * time_scale(path, columns[0], units)
-    return t, raw[:, 1:4], raw[:, 4:7], raw[:, 7:10] if have_mag else None, found
+    scale = time_scale(path, columns[0], units)
+    return raw[:, 0], scale, raw[:, 1:4], raw[:, 4:7], raw[:, 7:10] if have_mag else None, found
 
 
 def _source(path: Path, columns, sample_rate_hz: float | None, delimiter: str | None):
-    """``(t, gyro, acc, mag, units found, whose, nominal period)`` of a BROAD .mat or a CSV."""
+    """``(stamps, seconds per stamp unit, gyro, acc, mag, units found, whose, nominal
+    period)`` of a BROAD .mat or a CSV."""
     if path.suffix.lower() == ".mat":
         from strapdown.io.broad import read_broad
 
@@ -144,11 +162,11 @@ def _source(path: Path, columns, sample_rate_hz: float | None, delimiter: str | 
             raise InputError(f"{path}: the file states a sampling rate of {1 / tr.h:g} Hz, not "
                              f"the {sample_rate_hz:g} Hz given")
         whose = ("the file's", " (BROAD stores the gyro in rad/s, the accelerometer in m/s²)")
-        return tr.t, tr.gyro, tr.acc, tr.mag, _BROAD_UNITS, whose, None
+        return tr.t, 1.0, tr.gyro, tr.acc, tr.mag, _BROAD_UNITS, whose, None
     if path.suffix.lower() in (".csv", ".txt", ".tsv"):
-        t, g, a, m, found = _csv(path, columns, delimiter)
+        t, scale, g, a, m, found = _csv(path, columns, delimiter)
         nominal = None if sample_rate_hz is None else 1.0 / sample_rate_hz
-        return t, g, a, m, found, ("the header's", ""), nominal
+        return t, scale, g, a, m, found, ("the header's", ""), nominal
     raise InputError(f"{path}: unsupported format {shown(path.suffix, 20)} (use a BROAD .mat or "
                      "a CSV)")
 
@@ -167,44 +185,116 @@ def _check_range(path: Path, what: str, values: np.ndarray, limit: float, unit: 
 def read_ahrs_log(path, *, gyro_units: str | None = None, acc_units: str | None = None,
                   columns=None, use_magnetometer: bool = True,
                   sample_rate_hz: float | None = None, gap_tolerance: float = 1.5,
-                  unit_check: UnitAction = "warn", delimiter: str | None = None) -> AhrsLog:
+                  unit_check: UnitAction = "warn", delimiter: str | None = None,
+                  timing_mode: TimingMode = "auto", jitter_tolerance: float = JITTER_TOLERANCE,
+                  held: HeldPolicy = "auto", duplicates: DuplicatePolicy = "error") -> AhrsLog:
     """Read and validate a recording (see the module docstring).
 
     Every problem is an :class:`~strapdown.InputError` naming the file: besides the checks
     ``run`` makes (:func:`strapdown.io.read_imu`: finite rows, time steps, no sample turning
     the body by more than π), an accelerometer norm above :data:`ACC_LIMIT` m/s² or a
     magnetometer norm above :data:`MAG_LIMIT` (its own unit) is refused.
+
+    Units the file does not declare are inferred where the data decide
+    (:func:`infer_acc_units`: a median norm near 9.8 is m/s², near 1 is g;
+    :func:`infer_gyro_units`: the magnetometer's rotation against the gyro's) and listed
+    in :attr:`AhrsLog.inferred`. The time base is :func:`strapdown.io.timing.reconstruct`'s
+    (held rows, duplicated stamps, the fitted clock): ``timing_mode``, ``jitter_tolerance``,
+    ``held`` and ``duplicates`` as for :func:`strapdown.io.read_imu`.
     """
     check_read_options(kind="rate", units=None, gap_tolerance=gap_tolerance, on_gap="report",
                        saturation=None, sample_rate_hz=sample_rate_hz)
     path = input_file(path, "recording")
-    t, g, a, m, found, whose, nominal = _source(path, columns, sample_rate_hz, delimiter)
+    raw, scale, g, a, m, found, whose, nominal = _source(path, columns, sample_rate_hz,
+                                                         delimiter)
+    if raw.size < 2:
+        raise InputError(f"{path}: {raw.size} samples; at least 2 are needed")
+    check_finite_rows(path, [("time", [raw]), ("gyro", [g]), ("accelerometer", [a]),
+                             *((("magnetometer", [m]),) if m is not None else ())])
+    check_stamp_steps(path, raw, scale)
+    base = relative_times(raw, scale)
+    values = np.column_stack([g, a] + ([m] if m is not None else []))
+    timing = reconstruct(path, base, values, period=nominal, mode=timing_mode, held=held,
+                         duplicates=duplicates, jitter_tolerance=jitter_tolerance,
+                         fit=path.suffix.lower() != ".mat")
+    keep = timing.cleaning.keep
+    if keep.size < raw.size:
+        g, a = g[keep], a[keep]
+        m = None if m is None else m[keep]
+    if keep.size < 2:
+        raise InputError(f"{path}: {keep.size} distinct samples; at least 2 are needed")
+    t_rel = base.t[keep]
+    t = base.origin + t_rel if abs(base.origin) >= EPOCH_LIKE_S else raw[keep] * scale
+    inferred: dict[str, str] = {}
+    if found["accelerometer"] is None and acc_units is None:
+        acc_units = infer_acc_units(path, a)
+        inferred["accelerometer"] = acc_units
+    if found["gyro"] is None and gyro_units is None and m is not None and use_magnetometer:
+        gyro_units = infer_gyro_units(path, t_rel, g, m)
+        inferred["gyro"] = gyro_units
     gu = _unit(path, "gyro", "--gyro-units", GYRO_UNITS, gyro_units, found["gyro"], whose)
     au = _unit(path, "accelerometer", "--acc-units", ACC_UNITS, acc_units,
                found["accelerometer"], whose)
-    if t.size < 2:
-        raise InputError(f"{path}: {t.size} samples; at least 2 are needed")
-    check_rows(path, t, [("time", [t]), ("gyro", [g]), ("accelerometer", [a]),
-                         *((("magnetometer", [m]),) if m is not None else ())])
     if gu == "deg/s":
         g = np.radians(g)
     if au == "g":
         a = a * 9.80665
     warn_implausible_rate(path, g, gu, suggestion="deg/s", action=unit_check)
     if m is not None and use_magnetometer:
-        _check_gyro_scale(path, t, g, m, gu, unit_check)
-    d = np.diff(t)
-    unit_h = nominal or float(np.median(d))
+        _check_gyro_scale(path, t_rel, g, m, gu, unit_check)
+    d = np.diff(t_rel)
+    clock = timing.clock
+    unit_h = nominal or (clock.period if clock is not None and timing.on_clock
+                         else float(np.median(d)))
     check_motion(path, g, "rate", unit_h)
     _check_range(path, "accelerometer", a, ACC_LIMIT, "m/s²")
     if m is not None:
         _check_range(path, "magnetometer", m, MAG_LIMIT, "(its unit)")
     if m is not None and not np.any(m):
         use_magnetometer = False
-    gaps = [int(i) + 2 for i in np.flatnonzero(d > gap_tolerance * unit_h)]
+    if clock is not None and timing.on_clock:
+        gaps = [int(timing.rows[i]) for i in clock.gap_rows()]
+    else:
+        gaps = [int(timing.rows[i + 1]) for i in np.flatnonzero(d > gap_tolerance * unit_h)]
     return AhrsLog(t, np.ascontiguousarray(g), np.ascontiguousarray(a),
                    None if (m is None or not use_magnetometer) else np.ascontiguousarray(m),
-                   gu, au, gaps, nominal)
+                   gu, au, gaps, nominal, timing, inferred)
+
+
+#: Accelerometer norms (median over the recording) that decide its unit: within these
+#: bounds of 9.80665 m/s² it is m/s², of 1 it is g (a body that is not in free fall or
+#: under sustained thrust reads about gravity on average).
+ACC_NORM_BOUNDS = (0.7, 1.3)
+
+
+def infer_acc_units(path: Path, acc: np.ndarray) -> str:
+    """``m/s2`` or ``g`` from the accelerometer's median norm (:data:`ACC_NORM_BOUNDS`),
+    else an error asking for ``--acc-units``."""
+    norm = float(np.median(np.linalg.norm(acc, axis=1)))
+    lo, hi = ACC_NORM_BOUNDS
+    if lo * 9.80665 <= norm <= hi * 9.80665:
+        return "m/s2"
+    if lo <= norm <= hi:
+        return "g"
+    raise InputError(f"{path}: the accelerometer's median norm is {norm:.4g}, neither about "
+                     "9.8 (m/s²) nor about 1 (g); pass --acc-units (m/s2 or g) if it is "
+                     "specific force, and check the columns")
+
+
+def infer_gyro_units(path: Path, t: np.ndarray, gyro: np.ndarray, field: np.ndarray) -> str:
+    """``rad/s`` or ``deg/s`` when the magnetometer's rotation decides (:func:`gyro_scale`
+    ≈ 1 read as rad/s, ≈ π/180 as deg/s), else an error asking for ``--gyro-units``."""
+    s = gyro_scale(t, gyro, field)
+    lo, hi = GYRO_SCALE_LIMITS
+    if s is not None and lo <= s <= hi:
+        return "rad/s"
+    if s is not None and lo <= s * 180.0 / np.pi <= hi:
+        return "deg/s"
+    why = ("the recording turns too little to tell" if s is None
+           else f"the magnetometer turns {s:.3g} times as fast as the gyro read as rad/s")
+    raise InputError(f"{path}: no gyro units declared and the data do not decide ({why}); "
+                     "pass --gyro-units (rad/s or deg/s) or write them in the header "
+                     "(gx[deg/s])")
 
 
 #: Gyro scale against the magnetometer outside which the declared unit is judged wrong: a
@@ -280,12 +370,85 @@ def _merge(parts: list[AhrsResult], starts: list[int]) -> AhrsResult:
     return dataclasses.replace(parts[0], **cat)
 
 
+#: Longest gap (s) the filter bridges without ``--on-gap split``: over a gap the gyro is
+#: interpolated linearly between the samples either side (the attitude propagated across
+#: the actual interval) and the accelerometer and magnetometer likewise; their error grows
+#: with the motion the gap hides, so longer gaps are refused.
+BRIDGE_MAX_S = 1.0
+
+
+def _select(res: AhrsResult, rows: np.ndarray, t: np.ndarray) -> AhrsResult:
+    """The rows ``rows`` of a result over a bridged grid, at the times ``t``."""
+    cut: dict[str, Any] = {}
+    n = res.t.size
+    for f in dataclasses.fields(res):
+        v = getattr(res, f.name)
+        if isinstance(v, np.ndarray) and v.shape[:1] == (n,):
+            cut[f.name] = v[rows]
+    cut["t"] = t
+    cut["index"] = np.arange(rows.size)
+    return dataclasses.replace(res, **cut)
+
+
+def _bridge(imu: Path, log: AhrsLog, algorithm: str, frame: str,
+            config: AhrsConfig | None, offline: bool) -> AhrsResult:
+    """The filter over the fitted clock's full grid, missing samples interpolated, its
+    outputs at the recorded samples (at their clock times)."""
+    timing = log.timing
+    assert timing is not None and timing.clock is not None
+    clock = timing.clock
+    ticks = clock.ticks
+    lengths = clock.gap_lengths()
+    if lengths.size and lengths.max() * clock.period > BRIDGE_MAX_S:
+        i = int(np.argmax(lengths))
+        row = int(timing.rows[clock.gap_rows()[i]])
+        raise InputError(f"{imu}: a gap of {int(lengths[i])} missing samples "
+                         f"({lengths[i] * clock.period:.3g} s) before data row {row}, longer "
+                         f"than the {BRIDGE_MAX_S:g} s the filter bridges; pass --on-gap split "
+                         "(each segment filtered from the previous one's last attitude)")
+    origin = timing.base.origin
+    uniform = clock.kind == "uniform" and not lengths.size and log.nominal_period is None
+    if uniform:
+        full, t_grid = ticks, log.t
+        gyro, acc, mag = log.gyro, log.acc, log.mag
+    else:
+        full = np.arange(int(ticks[-1]) + 1)
+        t_grid = origin + clock.uniform_times(full)
+
+        def fill(x):
+            if x is None or not lengths.size:
+                return x
+            return np.column_stack([np.interp(full, ticks, x[:, j]) for j in range(3)])
+
+        gyro, acc, mag = fill(log.gyro), fill(log.acc), fill(log.mag)
+    r = (offline_ekf if offline else ekf)(t_grid, gyro, acc, mag, algorithm=algorithm,
+                                          config=config, frame=frame)
+    _check_output(r, log.gyro_units)
+    if uniform:
+        return r
+    return _select(r, ticks, origin + clock.times())
+
+
 def _filter(imu: Path, log: AhrsLog, algorithm: str, frame: str, config: AhrsConfig | None,
             split: bool, resample: bool, offline: bool = False):
-    """The filter (``offline``: :func:`~strapdown.ahrs.offline_ekf`, acausal) over each
-    gap-free segment; ``(result, segment per output, time base)``."""
+    """The filter (``offline``: :func:`~strapdown.ahrs.offline_ekf`, acausal) over the
+    recording; ``(result, segment per output, time base)``.
+
+    Samples on the fitted sensor clock (:attr:`strapdown.io.timing.Timing.on_clock`) run on
+    its grid, gaps up to :data:`BRIDGE_MAX_S` bridged (:func:`_bridge`) unless ``split``;
+    otherwise (``resample``, irregular sampling, ``--timing stamps``, ``split``) each
+    gap-free segment runs on its uniform record (:func:`strapdown.apps._logs.rate_records`),
+    from the previous segment's last attitude and bias.
+    """
     glog = ImuLog(log.t, log.gyro, "rate", float(np.median(np.diff(log.t))), log.gaps, [],
-                  "rad/s", log.nominal_period)
+                  "rad/s", log.nominal_period, log.timing)
+    timing = log.timing
+    if not split and not resample and timing is not None and timing.on_clock:
+        r = _bridge(imu, log, algorithm, frame, config, offline)
+        clock = timing.clock
+        assert clock is not None
+        base = JitterSummary(clock.period, clock.residual_max / clock.period, False, 1, timing)
+        return r, np.zeros(r.t.size), base
     recs, base = rate_records(imu, glog, split=split, min_samples=4, resample=resample)
     cuts = glog.segments() if split else [slice(0, log.t.size)]
     parts, seg = [], []
@@ -310,18 +473,27 @@ def run_ahrs(imu, out, *, algorithm: str = "rate-single", frame: str = "ENU",
              sample_rate_hz: float | None = None, on_gap: str = "report",
              gap_tolerance: float = 1.5, resample: bool = False,
              accept_unit_warning: bool = False, delimiter: str | None = None,
-             offline: bool = False) -> tuple[AhrsResult, dict[str, Any]]:
+             offline: bool = False, timing: TimingMode = "auto",
+             jitter_tolerance: float = JITTER_TOLERANCE, held: HeldPolicy = "auto",
+             duplicates: DuplicatePolicy = "error") -> tuple[AhrsResult, dict[str, Any]]:
     """Filter a recording and write the attitude, biases and metadata atomically.
 
     ``offline``: post-processing with :func:`~strapdown.ahrs.offline_ekf` — the filter run
     forward and backward and the two combined, acausal (every estimate uses the whole
     recording); the metadata's ``mode`` says which.
 
-    ``on_gap``: ``"split"`` filters each gap-free segment from the previous one's last
-    attitude and bias (covariance reset; the motion during the gap is not observed);
-    ``"report"`` and ``"error"`` fail at a gap. ``resample`` interpolates jittered gyro,
-    accelerometer and magnetometer samples onto the uniform grid. ``delimiter``: a CSV's
-    (default: detected). Anything wrong with the input is an :class:`~strapdown.InputError`.
+    ``on_gap``: ``"report"`` bridges gaps of up to :data:`BRIDGE_MAX_S` on the sensor's
+    fitted clock (reported; longer ones are an error), ``"split"`` filters each gap-free
+    segment from the previous one's last attitude and bias (covariance reset; the motion
+    during the gap is not observed), ``"error"`` fails at a gap. ``timing``,
+    ``jitter_tolerance``, ``held``, ``duplicates``: the time base
+    (:func:`read_ahrs_log`); ``resample`` is ``timing="resample"``: gyro, accelerometer
+    and magnetometer interpolated onto the uniform grid. ``delimiter``: a CSV's (default:
+    detected). Anything wrong with the input is an :class:`~strapdown.InputError`.
+
+    Output columns: ``t`` (each sample's time on the fitted clock, in the file's time
+    base), ``qw,qx,qy,qz``, ``yaw_deg,pitch_deg,roll_deg`` (z-y-x of the same q_n_b),
+    ``bias_x,bias_y,bias_z`` (rad/s) (+ ``segment`` when split).
     """
     imu, out = Path(imu), Path(out)
     if out.resolve() == imu.resolve():
@@ -335,19 +507,27 @@ def run_ahrs(imu, out, *, algorithm: str = "rate-single", frame: str = "ENU",
         log = read_ahrs_log(imu, gyro_units=gyro_units, acc_units=acc_units, columns=columns,
                             use_magnetometer=use_magnetometer, sample_rate_hz=sample_rate_hz,
                             gap_tolerance=gap_tolerance,
-                            unit_check=unit_action(accept_unit_warning), delimiter=delimiter)
+                            unit_check=unit_action(accept_unit_warning), delimiter=delimiter,
+                            timing_mode="resample" if resample else timing,
+                            jitter_tolerance=jitter_tolerance, held=held,
+                            duplicates=duplicates)
         if log.gaps and on_gap == "error":
             r = log.gaps[0]
-            raise InputError(f"{imu}: gap of {log.t[r - 1] - log.t[r - 2]:.6g} s before data "
-                             f"row {r}")
+            i = int(np.searchsorted(log.timing.rows, r)) if log.timing is not None else r - 1
+            raise InputError(f"{imu}: gap of {log.t[i] - log.t[i - 1]:.6g} s before data "
+                             f"row {r} (--on-gap error); the default --on-gap report bridges "
+                             f"gaps up to {BRIDGE_MAX_S:g} s, --on-gap split runs each segment")
         res, seg, base = _filter(imu, log, algorithm, frame, config, on_gap == "split",
-                                 resample, offline)
-        extra = {"bias_x": res.gyro_bias[:, 0], "bias_y": res.gyro_bias[:, 1],
-                 "bias_z": res.gyro_bias[:, 2]}
+                                 resample or timing == "resample", offline)
+        yaw, pitch, roll = euler_zyx_from_dcm(dcm_from_quat(res.q))
+        extra = {"yaw_deg": np.degrees(yaw), "pitch_deg": np.degrees(pitch),
+                 "roll_deg": np.degrees(roll), "bias_x": res.gyro_bias[:, 0],
+                 "bias_y": res.gyro_bias[:, 1], "bias_z": res.gyro_bias[:, 2]}
         if on_gap == "split":
             extra["segment"] = seg
+        origin = log.timing.base.origin_text if log.timing is not None else None
         with output_with_sidecar(out) as paired:
-            write_attitude(paired.path, res.t, res.q, extra=extra)
+            write_attitude(paired.path, res.t, res.q, extra=extra, time_origin=origin)
             paired.meta = _metadata(imu, log, res, algorithm, frame, base, on_gap,
                                     [str(w.message) for w in caught])
     return res, paired.meta
@@ -369,7 +549,11 @@ def _metadata(imu: Path, log: AhrsLog, res: AhrsResult, algorithm: str, frame: s
         "magnetometer_used": (res.fraction(MeasurementFlag.MAG_USED) if res.heading_observed
                               else 0.0),
         "rest_updates": res.fraction(MeasurementFlag.REST),
-        "gyro_units": log.gyro_units, "acc_units": log.acc_units, **base.to_dict(),
+        "gyro_units": log.gyro_units, "acc_units": log.acc_units,
+        "units_inferred": log.inferred, **base.to_dict(),
+        "columns": ["t", "qw", "qx", "qy", "qz", "yaw_deg", "pitch_deg", "roll_deg", "bias_x",
+                    "bias_y", "bias_z", *(["segment"] if on_gap == "split" else [])],
+        "euler": "yaw_deg, pitch_deg, roll_deg: z-y-x angles of q_n_b (deg)",
         "time_base": base.describe(), "on_gap": on_gap,
         "gaps": {"count": len(log.gaps), "first_rows": log.gaps[:100]},
         "warnings": caught, "version": __version__,

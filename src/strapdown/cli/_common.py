@@ -212,32 +212,68 @@ def size(text: str) -> int:
 
 def log_check_args(p: argparse.ArgumentParser, *, saturation: bool = True) -> None:
     """What to do about a log's faults and time base: ``--on-gap``, ``--gap-tolerance``,
-    ``--saturation`` (with ``saturation``), ``--resample``, ``--accept-unit-warning``."""
-    from strapdown.algorithms.rate import JITTER_TOLERANCE
+    ``--saturation`` (with ``saturation``), the time base (:func:`timing_args`),
+    ``--accept-unit-warning``."""
     from strapdown.apps.run import RUN_GAP_POLICIES
 
-    g = p.add_argument_group("log checks")
+    g = p.add_argument_group("log checks and time base")
     g.add_argument("--on-gap", choices=RUN_GAP_POLICIES, default="report",
-                   help="gaps (intervals over --gap-tolerance sample periods): report them "
-                   "(an increment log bridges them; a rate log with a gap fails), fail, or run "
-                   "each gap-free segment on its own from the previous one's last attitude "
-                   "(a segment column is added)")
+                   help="gaps (samples missing on the fitted clock; without one, intervals over "
+                   "--gap-tolerance periods): report them (the AHRS and an increment log bridge "
+                   "them; a rate algorithm cannot and fails), fail, or run each gap-free "
+                   "segment on its own from the previous one's last attitude (a segment column "
+                   "is added)")
     g.add_argument("--gap-tolerance", type=float, default=1.5,
-                   help="gap threshold in sample periods (the median interval, or "
-                   "1/--sample-rate-hz)")
+                   help="gap threshold in sample periods when the samples are not on a fitted "
+                   "clock (--timing stamps or resample, irregular sampling)")
     if saturation:
         g.add_argument("--saturation", type=float, default=None,
                        help="sensor range in the declared unit; saturated rows are reported")
-    g.add_argument("--resample", action="store_true",
-                   help="rate logs whose time stamps jitter (each within "
-                   f"{JITTER_TOLERANCE:g} period of a uniform grid): interpolate the rates onto "
-                   "the grid (cubic spline; right when the samples were taken at the stamps) "
-                   "instead of taking them to lie on it (right when the sensor samples on its "
-                   "own clock and only the stamps jitter)")
+    timing_args(g)
     g.add_argument("--accept-unit-warning", action="store_true",
                    help="run although the magnitudes suggest another unit than declared "
                    "(e.g. a 99th-percentile rate over 200 rad/s declared as rad/s); without it "
                    "that is an error and nothing is written")
+
+
+def timing_args(g: Options) -> None:
+    """The time base of a recording (:mod:`strapdown.io.timing`): ``--timing``,
+    ``--jitter-tolerance``, ``--held``, ``--duplicate-stamps`` and ``--resample``."""
+    from strapdown.io.timing import (
+        DUPLICATE_POLICIES,
+        HELD_POLICIES,
+        JITTER_TOLERANCE,
+        TIMING_MODES,
+    )
+
+    g.add_argument("--timing", choices=TIMING_MODES, default="auto",
+                   help="how the time stamps are taken. The sensor's own clock is fitted to "
+                   "them (period, offset, slow drift; gaps are whole missing periods). auto: "
+                   "samples on that clock when the stamps are noise, rounding or drift around "
+                   "it, resampled when the sampling is irregular; nominal: on the clock "
+                   "whatever the residuals; stamps: the stamps are the sample times (rate "
+                   "algorithms then need them uniform); resample: the samples were taken at the "
+                   "stamps, interpolated onto a uniform grid (default: auto)")
+    g.add_argument("--jitter-tolerance", type=float, default=JITTER_TOLERANCE,
+                   metavar="PERIODS",
+                   help="largest stamp deviation from the fitted clock (99th percentile, in "
+                   f"sample periods, below 0.5) that is stamp noise (default {JITTER_TOLERANCE:g})")
+    g.add_argument("--held", choices=HELD_POLICIES, default="auto",
+                   help="held samples (rows repeating every sensor value of the row before, "
+                   "written by a logger faster than its sensor): collapse them to their first "
+                   "stamp when the fitted clock confirms it (auto), always, or keep them")
+    g.add_argument("--duplicate-stamps", choices=DUPLICATE_POLICIES, default="error",
+                   help="a time stamp repeated with different values: an error naming the rows, "
+                   "or keep the first or the last (a repeat with identical values is dropped)")
+    g.add_argument("--resample", action="store_true",
+                   help="the same as --timing resample")
+
+
+def timing_options(args: argparse.Namespace) -> dict[str, object]:
+    """The :func:`timing_args` options as keywords of the readers and commands."""
+    return {"timing": "resample" if getattr(args, "resample", False) else args.timing,
+            "jitter_tolerance": args.jitter_tolerance, "held": args.held,
+            "duplicates": args.duplicate_stamps}
 
 
 def progress_args(p: Options, what: str = "a progress bar") -> None:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from strapdown.cli._common import columns, input_args, log_check_args, say
+from strapdown.cli._common import columns, input_args, log_check_args, say, timing_options
 
 __all__ = ["MAX_DECLINATION_DEG", "add_parser", "run"]
 
@@ -37,15 +37,20 @@ def _arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--frame", choices=["ENU", "NED"], default="ENU",
                    help="reference frame n of q_n_b")
     p.add_argument("--gyro-units", choices=GYRO_UNITS, default=None,
-                   help="gyro units; required unless the file declares them: a CSV header "
-                   "(gx[deg/s]) or BROAD (rad/s); one the file contradicts is an error")
+                   help="gyro units; required unless the file declares them (a CSV header "
+                   "gx[deg/s], BROAD: rad/s) or the magnetometer decides (its rotation against "
+                   "the gyro's); one the file contradicts is an error")
     p.add_argument("--acc-units", choices=ACC_UNITS, default=None,
-                   help="accelerometer units; required unless the file declares them: a CSV "
-                   "header (ax[g]) or BROAD (m/s2)")
+                   help="accelerometer units (default: the file's — a CSV header ax[g], BROAD "
+                   "m/s2 — else inferred from the median norm: about 9.8 is m/s2, about 1 is "
+                   "g). The magnetometer takes no unit: only its direction and constancy "
+                   "matter")
     p.add_argument("--columns", default=None,
-                   help="CSV columns: time, gyro xyz, accelerometer xyz[, magnetometer xyz] "
-                   "(default: found in the header — time t, time, timestamp, t[ms] …; gx,gy,gz; "
-                   "ax,ay,az; mx,my,mz when present)")
+                   help="CSV columns: time, gyro xyz, accelerometer xyz[, magnetometer xyz], "
+                   "by name or 0-based index (e.g. 0,8,9,10,5,6,7,11,12,13) (default: found "
+                   "in the header — time t, time, timestamp, t[ms], timestamp_ms …; gx,gy,gz; "
+                   "ax,ay,az; mx,my,mz when present). A second header row of units (s;rad/s…) "
+                   "or of axis names under group names is read too")
     p.add_argument("--sample-rate-hz", type=float, default=None,
                    help="the sensor's sample rate (Hz): the nominal period of jittered time "
                    "stamps (default: from the stamps)")
@@ -83,13 +88,16 @@ def run(args: argparse.Namespace) -> int:
                          columns=None if args.columns is None else columns(args.columns),
                          use_magnetometer=not args.no_mag, sample_rate_hz=args.sample_rate_hz,
                          on_gap=args.on_gap, gap_tolerance=args.gap_tolerance,
-                         resample=args.resample, accept_unit_warning=args.accept_unit_warning,
-                         delimiter=args.delimiter, offline=args.offline)
+                         accept_unit_warning=args.accept_unit_warning,
+                         delimiter=args.delimiter, offline=args.offline, **timing_options(args))
     for w in meta["warnings"]:
         say(f"warning: {w}")
     if meta["gaps"]["count"]:
-        say(f"warning: {meta['gaps']['count']} gap(s) (split into segments), first at data row "
+        how = "split into segments" if args.on_gap == "split" else "bridged"
+        say(f"warning: {meta['gaps']['count']} gap(s) ({how}), first at data row "
             f"{meta['gaps']['first_rows'][0]}")
+    for what, unit in meta["units_inferred"].items():
+        say(f"note: {what} units inferred from the data: {unit}")
     if not res.heading_observed:
         say("warning: no magnetometer: heading is not observed (gyro integral from yaw 0)")
     print(f"wrote {args.out} ({meta['outputs']} attitudes, {meta['mode'].split(' ')[0]}, "

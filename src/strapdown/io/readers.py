@@ -63,6 +63,7 @@ from strapdown.io.timing import (
     HeldPolicy,
     Timing,
     TimingMode,
+    format_times,
     reconstruct,
     relative_times,
 )
@@ -179,10 +180,17 @@ class ImuLog:
     def segments(self) -> list[slice]:
         """Index ranges between gaps: each a gap-free run of samples.
 
-        A gap reported at data row ``r`` (1-based) starts a new segment at index ``r − 1``.
+        A gap reported at data row ``r`` (1-based) starts a new segment at that row's sample.
         """
-        edges = [0, *(r - 1 for r in self.gaps), self.t.size]
+        edges = [0, *(self.index_of_row(r) for r in self.gaps), self.t.size]
         return [slice(a, b) for a, b in itertools.pairwise(edges)]
+
+    def index_of_row(self, row: int) -> int:
+        """The sample index of data row ``row`` (1-based; rows dropped or collapsed by the
+        time base do not count)."""
+        if self.timing is None:
+            return row - 1
+        return int(np.searchsorted(self.timing.rows, row))
 
 
 _UNIT = re.compile(r"^\s*([^\[\]]*?)\s*\[\s*([^\[\]]+?)\s*\]\s*$")
@@ -977,10 +985,15 @@ def check_finite_rows(path: str | os.PathLike[str],
 
 
 def write_attitude(path: str | os.PathLike[str], t: ArrayLike, q: NDArray[np.float64], *,
-                   extra: Mapping[str, ArrayLike] | None = None) -> Path:
+                   extra: Mapping[str, ArrayLike] | None = None,
+                   time_origin: str | None = None) -> Path:
     """Write ``t, qw, qx, qy, qz`` (+ extra columns) atomically as CSV or ``.npz``.
 
-    A non-finite value anywhere is an :class:`~strapdown.InputError` and nothing is written.
+    ``time_origin``: the first stamp exactly (:attr:`strapdown.io.timing.TimeBase.origin_text`);
+    for epoch-like stamps (beyond :data:`EPOCH_LIKE_S`) a CSV's times are then written as
+    that decimal plus the relative time to the microsecond (``1733119200.123``, not the
+    binary ``1733119200.1230001``). A non-finite value anywhere is an
+    :class:`~strapdown.InputError` and nothing is written.
     """
     path = Path(path)
     # Any: np.savez's column keywords share its signature with allow_pickle: bool
@@ -1001,7 +1014,16 @@ def write_attitude(path: str | os.PathLike[str], t: ArrayLike, q: NDArray[np.flo
         raise InputError(f"{path}: output must be .csv or .npz")
     names = list(cols)
     table = np.column_stack([np.asarray(cols[k], float) for k in names])
+    epoch = time_origin is not None and abs(float(time_origin)) >= EPOCH_LIKE_S
     with atomic_path(path) as tmp:
-        np.savetxt(tmp, table, delimiter=",", header=",".join(names), comments="",
-                   fmt="%.17g")
+        if not epoch:
+            np.savetxt(tmp, table, delimiter=",", header=",".join(names), comments="",
+                       fmt="%.17g")
+            return path
+        assert time_origin is not None
+        times = format_times(time_origin, table[:, 0] - float(time_origin), decimals=6)
+        with open(tmp, "w", encoding="utf-8") as f:
+            f.write(",".join(names) + "\n")
+            for s, row in zip(times, table[:, 1:].tolist(), strict=True):
+                f.write(s + "," + ",".join(repr(v) for v in row) + "\n")
     return path

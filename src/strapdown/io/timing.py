@@ -20,8 +20,10 @@ Rows (:func:`clean_rows`)
 
 Clock (:func:`fit_clock`)
     Each sample ``i`` is assigned a tick ``k_i`` of a clock ``T(k) = c + p·k (+ drift)``:
-    first locally, ``Δk = max(1, round(Δt / p))`` from a robust period (the mean interval
-    below 1.5 median intervals), then by least squares of the stamps on the ticks and a
+    first by runs — consecutive samples (intervals under 1.5 times a robust period, the
+    mean interval below 1.5 median intervals) are one tick apart, the period is the runs'
+    pooled least-squares slope, and a break between runs spans the whole number of periods
+    between their fitted lines —, then by least squares of the stamps on the ticks and a
     global re-rounding against the fitted clock, repeated until the ticks stop changing. A
     slowly drifting clock is fitted by a cubic in the tick (Legendre basis) when it
     explains the residuals. A **gap** is whole ticks missing on the fitted clock, not a late
@@ -449,14 +451,45 @@ def _fit(t: NDArray[np.float64], period: float | None, tol: float, *, drift: boo
             raise ValueError("the stamps overflow the clock fit") from None
 
 
+def _runs_ticks(t: NDArray[np.float64], d: NDArray[np.float64], p0: float,
+                period: float | None) -> tuple[NDArray[np.int64], float]:
+    """Ticks and period from runs of consecutive samples (intervals under 1.5 periods).
+
+    Within a run each sample is one tick on; the period is the pooled least-squares slope
+    of the runs (or ``period`` as given); each break between runs spans the whole number of
+    periods between the runs' fitted lines (their means, not two noisy stamps).
+    """
+    n = t.size
+    brk = np.flatnonzero(d > 1.5 * p0) + 1  # first sample of each run after the first
+    starts = np.concatenate([[0], brk])
+    lengths = np.diff(np.concatenate([starts, [n]]))
+    run = np.repeat(np.arange(starts.size), lengths)
+    m = np.arange(n) - starts[run]  # local index within the run
+    mbar = np.bincount(run, m) / lengths
+    tbar = np.bincount(run, t) / lengths
+    if period is None:
+        mc = m - mbar[run]
+        den = float(np.dot(mc, mc))
+        p = float(np.dot(mc, t - tbar[run]) / den) if den > 0 else p0
+        if not p > 0:
+            p = p0
+    else:
+        p = period
+    alpha = tbar - p * mbar  # each run's fitted time of its first sample
+    span = alpha[1:] - (alpha[:-1] + p * (lengths[:-1] - 1))
+    dk = np.maximum(1, np.rint(span / p)).astype(np.int64)
+    offsets = np.concatenate([[0], np.cumsum(lengths[:-1] - 1 + dk)])
+    return (offsets[run] + m).astype(np.int64), p
+
+
 def _fit_iterations(t: NDArray[np.float64], period: float | None, drift: bool
                     ) -> SampleClock:
     n = t.size
     d = np.diff(t)
-    p = period if period is not None else _robust_period(d)
-    if not p > 0:
+    p0 = period if period is not None else _robust_period(d)
+    if not p0 > 0:
         raise ValueError("no positive interval")
-    k = np.concatenate([[0], np.cumsum(np.maximum(1, np.rint(d / p)).astype(np.int64))])
+    k, p = _runs_ticks(t, d, p0, period)
     coef: tuple[float, ...] = ()
     c = 0.0
     collisions = 0
@@ -464,6 +497,7 @@ def _fit_iterations(t: NDArray[np.float64], period: float | None, drift: bool
         kf = k.astype(np.float64)
         c, p = _line(kf, t, period)
         span = int(k[-1])
+        coef = ()
         if drift and period is None and n >= 64 and span > 0:
             r = t - (c + p * kf)
             basis = _legendre(k, span)
@@ -473,17 +507,14 @@ def _fit_iterations(t: NDArray[np.float64], period: float | None, drift: bool
             if np.std(r - fitted) < 0.8 * np.std(r) and np.ptp(fitted) > 0.05 * p:
                 coef = (float(sol[0]), float(sol[1]))
                 c += float(np.mean(r - fitted))
-            else:
-                coef = ()
         model = c + p * kf + _drift_value(coef, k, span)
         k_new = k + np.rint((t - model) / p).astype(np.int64)
         k_new -= k_new[0]
-        # ticks must strictly increase: a stamp rounded onto its predecessor's tick moves on
         step = np.diff(k_new)
         collisions = int(np.sum(step < 1))
-        if collisions:
-            k_new = np.concatenate([[0], np.cumsum(np.maximum(step, 1))])
-        if np.array_equal(k_new, k):
+        if collisions or np.array_equal(k_new, k):
+            # two stamps on one tick: the sampling is not on this clock (or a stamp is an
+            # outlier); the ticks stay as they were and the residuals say how far off
             break
         k = k_new
     span = int(k[-1])
@@ -530,6 +561,14 @@ def fit_clock(t: NDArray[np.float64], *, period: float | None = None,
     except ValueError as exc:
         raise InputError(f"no sample clock fits the time stamps ({exc})") from None
     p = clock.period
+    if period is not None and clock.residual_p99 > jitter_tolerance * p:
+        free = _fit(t, None, jitter_tolerance, drift=False)
+        if free.residual_p99 <= jitter_tolerance * free.period:
+            raise InputError(
+                f"the time stamps are not at the given sample period {period:.9g} s "
+                f"({1 / period:.9g} Hz): they stray up to {clock.residual_p99 / p:.3g} periods "
+                f"from its clock, but lie on one of {1 / free.period:.9g} Hz; drop "
+                "--sample-rate-hz or correct it")
     kind: ClockKind
     if clock.residual_max <= UNIFORM_TOLERANCE * p and not clock.collisions:
         kind = "uniform"
@@ -586,7 +625,7 @@ class Timing:
         if self.mode != "auto":
             parts.append(f"timing {self.mode}")
         elif self.clock is not None and self.clock.kind == "irregular":
-            parts.append("resampled onto a uniform grid")
+            parts.append("resampled onto the uniform grid")
         return "; ".join(parts)
 
     def to_dict(self) -> dict[str, Any]:
