@@ -29,12 +29,18 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         "run", arguments=_arguments,
         help="attitude from a gyro log (CSV, .npy, .npz, .mat)",
         description="Validate a gyro log, run an algorithm over it (streamed for increment "
-        "logs) and write the attitude atomically: t,qw,qx,qy,qz (q_n_b) and the --angles "
-        "columns, one row per attitude update (rate-three: every 3 samples, rk4: every 2), and "
-        "beside it OUT.meta.json (input, algorithm, samples, update and sample period, jitter, "
-        "gaps, saturation, warnings, version). Jittered time stamps run on their nominal "
-        "period (or --resample); nothing is written on invalid input, on magnitudes that "
-        "suggest another unit (unless --accept-unit-warning) or on a non-finite result.")
+        "logs and for .npy rate logs with uniform stamps) and write the attitude atomically: "
+        "t,qw,qx,qy,qz (q_n_b) and the --angles columns, one row per attitude update "
+        "(rate-three: every 3 samples, rk4: every 2), and beside it OUT.meta.json (input, "
+        "algorithm, initial attitude, samples, update and sample period, jitter, gaps, "
+        "saturation, peak rate, total rotation, warnings, version). Frame: q_n_b takes body "
+        "vectors into n, the frame the initial attitude is given in (--init-attitude; "
+        "identity by default, so n is the body frame at the first sample). The summary line "
+        "gives the peak rate |w| (deg/s) and the total rotation (deg, the sum of the rotation "
+        "angles between successive attitudes): a rad/s log declared as deg/s shows as "
+        "'max 0.52 deg/s'. Jittered time stamps run on their nominal period (or --resample); "
+        "nothing is written on invalid input, on magnitudes that suggest another unit "
+        "(unless --accept-unit-warning) or on a non-finite result.")
     p.set_defaults(handler=run)
     return p
 
@@ -64,6 +70,11 @@ def _arguments(p: argparse.ArgumentParser) -> None:
                    "other algorithms)")
     g.add_argument("--coefficients", default=None,
                    help="coefficient set; " + coefficients_help(algorithms))
+    g.add_argument("--init-attitude", type=float, nargs="+", default=None,
+                   metavar="A",
+                   help="attitude at the first sample: YAW PITCH ROLL (deg, z-y-x, as nav "
+                   "--init-attitude) or a quaternion W X Y Z (q_n_b, normalised); default "
+                   "identity (n = the body frame at the first sample)")
     o = p.add_argument_group("output")
     o.add_argument("--angles", choices=ANGLES, default="ypr",
                    help="angles written beside the quaternion: yaw/pitch/roll, cone angles, or "
@@ -75,13 +86,15 @@ def _arguments(p: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     """Run the log and write the attitude and its metadata; gaps, saturation and warnings go
     to stderr."""
-    from strapdown.apps.run import run_log
+    from strapdown.apps.run import initial_attitude, run_log
 
+    q0 = initial_attitude(args.init_attitude)
     res = run_log(args.imu, args.out, kind=args.kind, units=args.units,
                   algorithm=args.algorithm, structure=args.structure,
                   subsamples=args.subsamples, coefficients=args.coefficients,
                   columns=None if args.columns is None else columns(args.columns),
-                  sample_rate_hz=args.sample_rate_hz, angles=args.angles, on_gap=args.on_gap,
+                  sample_rate_hz=args.sample_rate_hz, angles=args.angles, q0=q0,
+                  on_gap=args.on_gap,
                   gap_tolerance=args.gap_tolerance, saturation=args.saturation,
                   progress=progress(args), resample=args.resample,
                   accept_unit_warning=args.accept_unit_warning, delimiter=args.delimiter)
@@ -97,5 +110,7 @@ def run(args: argparse.Namespace) -> int:
             f"{saturated['first_rows'][0]}")
     base = f"; {res['time_base']}" if res["time_base"] else ""
     print(f"wrote {args.out}: {res['outputs']} attitudes from {res['samples']} samples "
-          f"({res['algorithm']}{base}) and {args.out}.meta.json")
+          f"({res['algorithm']}{base}; max {res['peak_rate_deg_s']:.3g} deg/s, total rotation "
+          f"{res['total_rotation_deg']:.4g} deg summed over the updates) and "
+          f"{args.out}.meta.json")
     return 0
