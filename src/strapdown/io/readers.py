@@ -558,7 +558,7 @@ def check_motion(path: str | os.PathLike[str], values: NDArray[np.float64], kind
     rad/s times the period ``h``, or increments in rad): such a log cannot be integrated
     (the units or the sample rate are wrong)."""
     if not MIN_PERIOD <= h <= MAX_PERIOD:
-        raise InputError(f"{path}: a sample period of {h!r} s; it must lie between "
+        raise InputError(f"{path}: a sample period of {h:.15g} s; it must lie between "
                          f"{MIN_PERIOD:g} and {MAX_PERIOD:g} s (check the time unit)")
     if values.shape[0] == 0:
         return
