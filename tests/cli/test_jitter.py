@@ -188,6 +188,7 @@ def test_ahrs_jittered_log(tmp_path, capsys, algorithm):
     # within 2× (the nominal period integrates them as if on the grid: documented)
     assert resampled <= 2 * clean
     assert nominal < 1e-2  # still finite and bounded: the filter corrects the tilt
-    assert re.search(r"jitter ±0\.5\d? % of it, resampled", capsys.readouterr().out)
+    assert re.search(r"stamp noise ±0\.005\d? period.*; resampled onto the uniform grid",
+                     capsys.readouterr().out)
     meta = json.loads((tmp_path / "a.csv.meta.json").read_text())
     assert meta["resampled"] is True and 0.004 < meta["jitter_periods"] < 0.0056

@@ -140,7 +140,14 @@ def test_ahrs_takes_header_units_and_refuses_contradictions(tmp_path, capsys):
     _fails(capsys, ["ahrs", "--imu", header, "--gyro-units", "rad/s", "--out",
                     str(tmp_path / "x.csv")],
            "declared gyro units 'rad/s' contradict the header's 'deg/s'", tmp_path, keep)
-    _fails(capsys, ["ahrs", "--imu", flags, "--out", str(tmp_path / "x.csv")],
+    # without units the magnetometer decides the gyro's (its rotation against the gyro's)
+    # and the norm the accelerometer's: the same result, each inference noted
+    assert main(["ahrs", "--imu", flags, "--out", str(tmp_path / "i.csv")]) == 0
+    assert (tmp_path / "i.csv").read_bytes() == (tmp_path / "f.csv").read_bytes()
+    assert "gyro units inferred from the data: deg/s" in capsys.readouterr().err
+    keep = sorted(p.name for p in tmp_path.iterdir())
+    # without a magnetometer nothing decides the gyro's unit
+    _fails(capsys, ["ahrs", "--imu", flags, "--no-mag", "--out", str(tmp_path / "x.csv")],
            "no gyro units declared; pass --gyro-units (rad/s or deg/s) or write them in the "
            "header (e.g. gx[deg/s])", tmp_path, keep)
 
@@ -148,14 +155,14 @@ def test_ahrs_takes_header_units_and_refuses_contradictions(tmp_path, capsys):
 def test_ahrs_gaps_fail_or_split(tmp_path, capsys):
     t, w, a, m = _imu(30.0)
     t = t.copy()
-    t[1500:] += 0.5  # a 0.51 s gap before data row 1501
+    t[1500:] += 1.5  # a 1.51 s gap before data row 1501: beyond what the filter bridges
     log = _csv(tmp_path / "imu.csv", PLAIN, t, w, a, m)
     units = ["--gyro-units", "rad/s", "--acc-units", "m/s2"]
     _fails(capsys, ["ahrs", "--imu", log, *units, "--out", str(tmp_path / "a.csv")],
-           "1 gap(s), the first of 0.51 s before data row 1501; rate algorithms cannot bridge "
-           "a gap: pass --on-gap split", tmp_path, ["imu.csv"])
+           "a gap of 150 missing samples (1.5 s) before data row 1501, longer than the 1 s the "
+           "filter bridges; pass --on-gap split", tmp_path, ["imu.csv"])
     _fails(capsys, ["ahrs", "--imu", log, *units, "--on-gap", "error", "--out",
-                    str(tmp_path / "a.csv")], "gap of 0.51 s before data row 1501", tmp_path,
+                    str(tmp_path / "a.csv")], "gap of 1.51 s before data row 1501", tmp_path,
            ["imu.csv"])
     assert main(["ahrs", "--imu", log, *units, "--on-gap", "split", "--out",
                  str(tmp_path / "a.csv")]) == 0
@@ -164,6 +171,26 @@ def test_ahrs_gaps_fail_or_split(tmp_path, capsys):
     assert np.all(out["t"][out["segment"] == 1.0] >= t[1500])
     meta = json.loads((tmp_path / "a.csv.meta.json").read_text())
     assert meta["segments"] == 2 and meta["gaps"]["first_rows"] == [1501]
+
+
+def test_ahrs_bridges_a_short_gap(tmp_path, capsys):
+    """A 0.5 s gap is bridged on the fitted clock: one output per recorded sample, the
+    attitude across the gap within the filter's own error of the gap-free run."""
+    t, w, a, m = _imu(30.0)
+    keep = np.r_[0:1500, 1550:t.size]  # 50 samples (0.5 s) missing
+    units = ["--gyro-units", "rad/s", "--acc-units", "m/s2"]
+    full = _csv(tmp_path / "full.csv", PLAIN, t, w, a, m)
+    log = _csv(tmp_path / "gap.csv", PLAIN, t[keep], w[keep], a[keep], m[keep])
+    assert main(["ahrs", "--imu", full, *units, "--out", str(tmp_path / "f.csv")]) == 0
+    assert main(["ahrs", "--imu", log, *units, "--out", str(tmp_path / "g.csv")]) == 0
+    assert "1 gap(s) (bridged), first at data row 1501" in capsys.readouterr().err
+    f = np.loadtxt(tmp_path / "f.csv", delimiter=",", skiprows=1)[keep]
+    g = np.loadtxt(tmp_path / "g.csv", delimiter=",", skiprows=1)
+    assert np.array_equal(f[:, 0], g[:, 0])
+    dot = np.abs(np.sum(f[:, 1:5] * g[:, 1:5], axis=1))
+    assert np.degrees(2 * np.arccos(np.minimum(dot, 1.0))).max() < 1.0
+    meta = json.loads((tmp_path / "g.csv.meta.json").read_text())
+    assert meta["timing"]["clock"]["missing_samples"] == 50
 
 
 @pytest.mark.parametrize("algorithm", ["rate-single", "rate-three", "rk4"])

@@ -313,6 +313,9 @@ def gyro_scale(t: np.ndarray, gyro: np.ndarray, field: np.ndarray) -> float | No
     mid = 0.5 * (field[:-1] + field[1:])
     pred = -np.cross(w, mid) * dt
     dm = np.diff(field, axis=0)
+    if dt.size:  # intervals across a gap: the linearised rotation does not hold there
+        ok = dt[:, 0] <= 1.5 * float(np.median(dt))
+        dt, w, mid, pred, dm = dt[ok], w[ok], mid[ok], pred[ok], dm[ok]
     den = float(np.sum(pred * pred))
     norm = np.linalg.norm(mid, axis=1)
     if not np.all(norm > 0):

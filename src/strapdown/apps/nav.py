@@ -50,11 +50,10 @@ from tqdm import tqdm
 from strapdown._core.errors import InputError
 from strapdown._core.kinds import InputKind
 from strapdown.algorithms.navigation import NavStream
-from strapdown.algorithms.rate import JITTER_TOLERANCE
+from strapdown.algorithms.rate import JITTER_TOLERANCE as STAMP_TOLERANCE
 from strapdown.algorithms.velocity import NavStructure
 from strapdown.io import read_imu
 from strapdown.io.containers import read_hdf5, read_mat, read_npz
-from strapdown.io.files import atomic_path
 from strapdown.io.readers import (
     ACC_COLUMNS,
     GYRO_COLUMNS,
@@ -67,6 +66,13 @@ from strapdown.io.readers import (
     csv_columns,
     csv_header,
     default_columns,
+)
+from strapdown.io.timing import (
+    JITTER_TOLERANCE,
+    DuplicatePolicy,
+    HeldPolicy,
+    Timing,
+    TimingMode,
 )
 from strapdown.rotation.dcm import quat_from_dcm
 from strapdown.rotation.euler import dcm_from_euler_zyx
@@ -111,6 +117,8 @@ class NavLog:
     h: float
     units: str | None
     acc_units: str
+    timing: Timing | None = None
+    bridged: int = 0  # samples interpolated over gaps
 
 
 def _csv_accel(path: Path, columns: Sequence[str] | None) -> tuple[NDArray[np.float64],
@@ -219,14 +227,15 @@ def _check_acc_range(path: Path, acc: NDArray[np.float64], unit: str, h: float) 
 
 
 def _uniform_period(path: Path, t: NDArray[np.float64], nominal: float | None) -> float:
-    """The sample period; stamps straying over :data:`JITTER_TOLERANCE` periods from the
-    uniform grid are an error (the navigation needs a fixed interval)."""
+    """The sample period of stamps taken as the sample times (``--timing stamps``); stamps
+    straying over 0.1 period from the uniform grid are an error (the navigation needs a fixed
+    interval)."""
     k = np.arange(t.size)
     td = nominal if nominal is not None else float((t[-1] - t[0]) / (t.size - 1))
     resid = (t - t[0]) - k * td
     resid -= resid.mean()
     worst = int(np.argmax(np.abs(resid)))
-    if abs(resid[worst]) > JITTER_TOLERANCE * td:
+    if abs(resid[worst]) > STAMP_TOLERANCE * td:
         raise InputError(f"{path}: time stamps not uniform: data row {worst + 1} lies "
                          f"{abs(resid[worst]) / td:.3g} periods off the grid of period "
                          f"{td:.9g} s; navigation needs uniformly sampled logs")
@@ -236,7 +245,9 @@ def _uniform_period(path: Path, t: NDArray[np.float64], nominal: float | None) -
 def read_nav_log(path: str | os.PathLike[str], *, kind: InputKind = "rate",
                  units: GyroUnit | None = None, acc_units: AccUnit | None = None,
                  columns: Sequence[str] | None = None, sample_rate_hz: float | None = None,
-                 unit_check: UnitAction = "error") -> NavLog:
+                 unit_check: UnitAction = "error", on_gap: NavGapPolicy = "error",
+                 timing: TimingMode = "auto", jitter_tolerance: float = JITTER_TOLERANCE,
+                 held: HeldPolicy = "auto", duplicates: DuplicatePolicy = "error") -> NavLog:
     """Read and validate a nav log (see the module docstring).
 
     Parameters
@@ -249,8 +260,18 @@ def read_nav_log(path: str | os.PathLike[str], *, kind: InputKind = "rate",
         The sensor's rate (needed where the file carries none).
     unit_check : {"warn", "error"}
         What magnitudes that suggest the other unit do (gyro and accelerometer).
+    on_gap : {"error", "report"}
+        A gap (samples missing on the sensor's fitted clock): an error, or bridged by
+        linear interpolation of both sensors when no longer than :data:`BRIDGE_MAX_S`
+        (reported; the navigation error grows with what the gap hides).
+    timing, jitter_tolerance, held, duplicates
+        The time base, as for :func:`strapdown.io.read_imu` (``timing="resample"``
+        interpolates both sensors onto a uniform grid, a cubic spline).
     """
     path = Path(path)
+    if on_gap not in NAV_GAP_POLICIES:
+        raise InputError(f"on_gap must be one of {', '.join(NAV_GAP_POLICIES)}, got "
+                         f"{on_gap!r}")
     if columns is not None and len(columns) != 7:
         raise InputError(f"columns must name time, three gyro and three accelerometer axes, "
                          f"got {len(columns)}: {list(columns)}")
@@ -262,18 +283,76 @@ def read_nav_log(path: str | os.PathLike[str], *, kind: InputKind = "rate",
     with np.errstate(over="ignore", invalid="ignore"):  # values beyond float64 (a float128
         log = read_imu(path, kind=kind, units=units,  # file) read as infinity, refused
                        columns=None if columns is None else list(columns[:4]),  # by row
-                       sample_rate_hz=sample_rate_hz, on_gap="error", unit_check=unit_check)
+                       sample_rate_hz=sample_rate_hz, on_gap="report", unit_check=unit_check,
+                       timing_mode=timing, jitter_tolerance=jitter_tolerance, held="keep",
+                       duplicates=duplicates)
         acc, stated = _accel_source(path, columns)
-    if acc.ndim != 2 or acc.shape != log.data.shape:
+    keep = log.timing.cleaning.keep if log.timing is not None else None
+    if acc.ndim != 2 or acc.shape[1:] != (3,) or (
+            acc.shape[0] != (log.timing.base.t.size if log.timing is not None
+                             else log.data.shape[0])):
         raise InputError(f"{path}: {log.data.shape[0]} gyro samples but accelerometer values of "
                          f"shape {acc.shape}")
+    if keep is not None and keep.size < acc.shape[0]:
+        acc = acc[keep]
     check_rows(path, log.t, [("accelerometer", [acc])])
     unit = _acc_unit(path, kind, acc_units, stated)
-    h = _uniform_period(path, log.t, log.nominal_period)
+    t, gyro, acc, h, bridged = _nav_grid(path, log, acc, on_gap)
     _check_acc_range(path, acc, unit, h)
     _check_acc_magnitude(path, acc if kind == "rate" else acc / h, unit, unit_check)
     si = acc * G0 if unit == "g" else acc
-    return NavLog(log.t, log.data, np.ascontiguousarray(si), kind, h, log.units, unit)
+    return NavLog(t, gyro, np.ascontiguousarray(si), kind, h, log.units, unit, log.timing,
+                  bridged)
+
+
+#: What ``nav`` does at a gap: fail, or bridge it (up to :data:`BRIDGE_MAX_S`).
+NavGapPolicy = Literal["error", "report"]
+NAV_GAP_POLICIES: tuple[NavGapPolicy, ...] = get_args(NavGapPolicy)
+#: Longest gap (s) ``nav --on-gap report`` bridges by interpolation.
+BRIDGE_MAX_S = 1.0
+
+
+def _nav_grid(path: Path, log, acc: NDArray[np.float64], on_gap: str):
+    """``(t, gyro, acc, h, bridged)`` on a uniform grid: the fitted sensor clock (gaps
+    bridged by linear interpolation), a uniform-stamp check (``timing="stamps"``), or both
+    sensors resampled onto a uniform grid (``resample``, irregular sampling)."""
+    timing = log.timing
+    clock = None if timing is None else timing.clock
+    if clock is None or timing.mode == "stamps":
+        return log.t, log.data, acc, _uniform_period(path, log.t, log.nominal_period), 0
+    p = clock.period
+    if timing.on_clock:
+        ticks = clock.ticks
+        lengths = clock.gap_lengths()
+        if lengths.size and (on_gap == "error" or lengths.max() * p > BRIDGE_MAX_S):
+            i = int(np.argmax(lengths))
+            row = int(timing.rows[clock.gap_rows()[i]])
+            raise InputError(
+                f"{path}: a gap of {int(lengths[i])} missing samples ({lengths[i] * p:.3g} s) "
+                f"before data row {row}; " + (
+                    "--on-gap report bridges gaps up to "
+                    f"{BRIDGE_MAX_S:g} s by interpolation" if on_gap == "error" else
+                    f"longer than the {BRIDGE_MAX_S:g} s --on-gap report bridges; split the "
+                    "log at the gap"))
+        if clock.kind == "uniform" and not lengths.size and log.nominal_period is None:
+            return log.t, log.data, acc, p, 0
+        full = np.arange(int(ticks[-1]) + 1)
+        t = float(log.t[0]) + (clock.uniform_times(full) - clock.uniform_times(ticks[:1])[0])
+        if not lengths.size:
+            return t, log.data, acc, p, 0
+
+        def fill(x):
+            return np.column_stack([np.interp(full, ticks, x[:, j]) for j in range(3)])
+
+        return t, fill(log.data), fill(acc), p, int(full.size - ticks.size)
+    from strapdown.algorithms.rate import resample_uniform
+
+    ts = log.t
+    step = p if clock.kind != "irregular" else float(np.median(np.diff(ts)))
+    m = int(np.floor((ts[-1] - ts[0]) / step * (1 + 1e-12))) + 1
+    grid = ts[0] + np.arange(m) * step
+    return (grid, resample_uniform(ts, log.data, grid), resample_uniform(ts, acc, grid),
+            step, 0)
 
 
 def increments_from_rates(w: ArrayLike, h: float) -> NDArray[np.float64]:
@@ -347,7 +426,10 @@ def navigate_log(imu: str | os.PathLike[str], out: str | os.PathLike[str], *, la
                  columns: Sequence[str] | None = None, sample_rate_hz: float | None = None,
                  subsamples: int = 2, structure: NavStructure = "conventional",
                  sculling: bool = True,
-                 accept_unit_warning: bool = False, progress: bool = False) -> dict[str, Any]:
+                 accept_unit_warning: bool = False, progress: bool = False,
+                 on_gap: NavGapPolicy = "error", timing: TimingMode = "auto",
+                 jitter_tolerance: float = JITTER_TOLERANCE, held: HeldPolicy = "auto",
+                 duplicates: DuplicatePolicy = "error") -> dict[str, Any]:
     """Navigate a log and write one row per update (see the module docstring).
 
     Parameters
@@ -362,8 +444,12 @@ def navigate_log(imu: str | os.PathLike[str], out: str | os.PathLike[str], *, la
         Magnitudes that suggest other units than declared warn instead of failing.
     progress : bool
         A progress bar on stderr.
+    on_gap, timing, jitter_tolerance, held, duplicates
+        The gap policy and the time base (:func:`read_nav_log`).
 
-    Returns a summary: samples, outputs, sample period, units, warnings.
+    Returns a summary (also written beside ``out`` as ``OUT.meta.json``): samples,
+    outputs, sample period, units, the time base (the fitted clock and its residuals),
+    bridged samples, warnings.
     """
     imu_path, out_path = Path(imu), Path(out)
     _check_out(imu_path, out_path)
@@ -372,7 +458,9 @@ def navigate_log(imu: str | os.PathLike[str], out: str | os.PathLike[str], *, la
         warnings.simplefilter("always")
         log = read_nav_log(imu_path, kind=kind, units=units, acc_units=acc_units,
                            columns=columns, sample_rate_hz=sample_rate_hz,
-                           unit_check="warn" if accept_unit_warning else "error")
+                           unit_check="warn" if accept_unit_warning else "error",
+                           on_gap=on_gap, timing=timing, jitter_tolerance=jitter_tolerance,
+                           held=held, duplicates=duplicates)
     if kind == "rate":
         g, a = increments_from_rates(log.gyro, log.h), increments_from_rates(log.accel, log.h)
         t0 = float(log.t[0])
@@ -380,10 +468,21 @@ def navigate_log(imu: str | os.PathLike[str], out: str | os.PathLike[str], *, la
         g, a, t0 = log.gyro, log.accel, float(log.t[0]) - log.h
     stream = NavStream(subsamples, h=log.h, lat=lat, lon=lon, height=hgt, v0=v0, q0=q0,
                        structure=structure, t0=t0, sculling=sculling)
-    n_out = _stream_to(out_path, stream, g, a, progress)
-    return {"samples": int(log.t.size), "outputs": n_out, "sample_period_s": log.h,
-            "update_period_s": stream.update_period, "units": log.units,
-            "acc_units": log.acc_units, "warnings": [str(w.message) for w in caught]}
+    from strapdown import __version__
+    from strapdown.apps._logs import output_with_sidecar
+
+    with output_with_sidecar(out_path) as paired:
+        n_out = _stream_to(paired.path, stream, g, a, progress)
+        paired.meta = {
+            "input": str(imu_path), "samples": int(log.t.size), "outputs": n_out,
+            "sample_period_s": log.h, "update_period_s": stream.update_period,
+            "units": log.units, "acc_units": log.acc_units, "columns": list(NAV_COLUMNS),
+            "frame": "NED; q_n_b Hamilton, scalar first; t: end of each update interval",
+            "on_gap": on_gap, "bridged_samples": log.bridged,
+            "timing": None if log.timing is None else log.timing.to_dict(),
+            "time_base": None if log.timing is None else log.timing.describe(),
+            "warnings": [str(w.message) for w in caught], "version": __version__}
+    return paired.meta
 
 
 def _stream_to(out: Path, stream: NavStream, g: NDArray[np.float64], a: NDArray[np.float64],
@@ -391,7 +490,8 @@ def _stream_to(out: Path, stream: NavStream, g: NDArray[np.float64], a: NDArray[
     """Feed the increments in chunks, writing each chunk's rows as they come."""
     csv_out = out.suffix.lower() == ".csv"
     parts, n_out = [], 0
-    with atomic_path(out) as tmp, open(tmp, "w", encoding="utf-8") as f, \
+    tmp = out  # a temporary path beside the target (output_with_sidecar renames it)
+    with open(tmp, "w", encoding="utf-8") as f, \
             tqdm(total=g.shape[0], disable=not progress, unit="sample", unit_scale=True,
                  file=sys.stderr) as bar:
         if csv_out:

@@ -12,7 +12,7 @@ import argparse
 import json
 import sys
 from collections.abc import Callable, Iterable
-from typing import TYPE_CHECKING, TypeVar
+from typing import TYPE_CHECKING, Any, TypeVar
 
 if TYPE_CHECKING:
     from strapdown.algorithms.family import Family
@@ -269,7 +269,7 @@ def timing_args(g: Options) -> None:
                    help="the same as --timing resample")
 
 
-def timing_options(args: argparse.Namespace) -> dict[str, object]:
+def timing_options(args: argparse.Namespace) -> dict[str, Any]:
     """The :func:`timing_args` options as keywords of the readers and commands."""
     return {"timing": "resample" if getattr(args, "resample", False) else args.timing,
             "jitter_tolerance": args.jitter_tolerance, "held": args.held,

@@ -5,7 +5,15 @@ from __future__ import annotations
 
 import argparse
 
-from strapdown.cli._common import columns, input_args, progress, progress_args, say
+from strapdown.cli._common import (
+    columns,
+    input_args,
+    progress,
+    progress_args,
+    say,
+    timing_args,
+    timing_options,
+)
 
 __all__ = ["add_parser", "run"]
 
@@ -50,6 +58,12 @@ def _arguments(p: argparse.ArgumentParser) -> None:
     g.add_argument("--accept-unit-warning", action="store_true",
                    help="run although magnitudes suggest other units than declared")
     input_args(g, delimiter=False)
+    tb = p.add_argument_group("gaps and time base")
+    tb.add_argument("--on-gap", choices=("error", "report"), default="error",
+                    help="a gap (samples missing on the sensor's fitted clock): fail (default), "
+                    "or bridge it by linear interpolation of gyro and accelerometer when no "
+                    "longer than 1 s (reported in the summary and OUT.meta.json)")
+    timing_args(tb)
     s = p.add_argument_group("initial state")
     s.add_argument("--init-lat", type=float, required=True, help="latitude (deg, within ±90)")
     s.add_argument("--init-lon", type=float, required=True,
@@ -85,9 +99,13 @@ def run(args: argparse.Namespace) -> int:
                        columns=None if args.columns is None else columns(args.columns),
                        sample_rate_hz=args.sample_rate_hz, subsamples=args.subsamples,
                        structure=args.structure, sculling=args.sculling,
-                       accept_unit_warning=args.accept_unit_warning, progress=progress(args))
+                       accept_unit_warning=args.accept_unit_warning, progress=progress(args),
+                       on_gap=args.on_gap, **timing_options(args))
     for w in res["warnings"]:
         say(f"warning: {w}")
+    if res["bridged_samples"]:
+        say(f"warning: {res['bridged_samples']} missing sample(s) bridged by interpolation")
+    base = f"; {res['time_base']}" if res["time_base"] else ""
     print(f"wrote {args.out}: {res['outputs']} updates from {res['samples']} samples "
-          f"(update every {res['update_period_s']:.6g} s)")
+          f"(update every {res['update_period_s']:.6g} s{base}) and {args.out}.meta.json")
     return 0
