@@ -288,17 +288,22 @@ def compare_log(imu: str | os.PathLike[str], specs: Iterable[str], out: str | os
                 progress: Callable[[str], None] | None = None, on_gap: str = "report",
                 gap_tolerance: float = 1.5, resample: bool = False,
                 accept_unit_warning: bool = False,
-                delimiter: str | None = None) -> list[AlgorithmRun]:
+                delimiter: str | None = None, timing: str = "auto",
+                jitter_tolerance: float | None = None, held: str = "auto",
+                duplicates: str = "error") -> list[AlgorithmRun]:
     """Run every spec on one gyro log and compare them (see the module docstring).
 
     The log is read as ``strapdown run`` reads it (:func:`strapdown.io.read_imu`; jittered
     rate stamps on their nominal period or ``resample``-d; ``on_gap="split"`` runs every
     spec over each gap-free segment from the previous one's last attitude; magnitudes that
     suggest another unit are an error unless ``accept_unit_warning``; ``delimiter``: the
-    CSVs', default detected). Anything wrong with the inputs is an :class:`~strapdown.InputError`.
+    CSVs', default detected; ``timing``, ``jitter_tolerance``, ``held``, ``duplicates``: the
+    time base, :func:`strapdown.io.read_imu`'s). Anything wrong with the inputs is an
+    :class:`~strapdown.InputError`.
     """
     from strapdown.apps._logs import log_segments, unit_action
     from strapdown.io import read_imu
+    from strapdown.io.timing import JITTER_TOLERANCE
 
     specs = list(specs)
     if not specs:
@@ -310,7 +315,11 @@ def compare_log(imu: str | os.PathLike[str], specs: Iterable[str], out: str | os
         log = read_imu(imu, kind=kind, units=units, columns=columns,  # with their row
                        sample_rate_hz=sample_rate_hz, gap_tolerance=gap_tolerance,
                        on_gap="error" if on_gap == "error" else "report",
-                       unit_check=unit_action(accept_unit_warning), delimiter=delimiter)
+                       unit_check=unit_action(accept_unit_warning), delimiter=delimiter,
+                       timing_mode="auto" if timing == "resample" else timing,  # type: ignore[arg-type]
+                       jitter_tolerance=jitter_tolerance or JITTER_TOLERANCE,
+                       held=held, duplicates=duplicates)  # type: ignore[arg-type]
+    resample = resample or timing == "resample"
     segments, base = log_segments(Path(imu), log, split=on_gap == "split", resample=resample,
                                   min_samples=max(_log_spec(f).min_samples for f in fields))
     h = segments[0].h

@@ -66,9 +66,11 @@ from strapdown.io.readers import (
     check_read_options,
     check_steps,
     input_file,
+    log_kind,
     npy_log,
     warn_implausible_rate,
 )
+from strapdown.io.timing import JITTER_TOLERANCE, DuplicatePolicy, HeldPolicy, TimingMode
 from strapdown.rotation.cone_angles import cone_angles_from_quat
 from strapdown.rotation.dcm import dcm_from_quat, quat_from_dcm
 from strapdown.rotation.euler import dcm_from_euler_zyx, euler_zyx_from_dcm
@@ -498,7 +500,8 @@ def _spec(kind: InputKind, algorithm: AlgorithmName | None, structure: Structure
     return spec
 
 
-def run_log(imu: str | os.PathLike[str], out: str | os.PathLike[str], *, kind: InputKind,
+def run_log(imu: str | os.PathLike[str], out: str | os.PathLike[str], *,
+            kind: InputKind | None,
             units: GyroUnit | None, algorithm: AlgorithmName | None = None,
             structure: StructureName = "conventional", subsamples: int | None = None,
             coefficients: CoefficientName | None = None, columns: Sequence[str] | None = None,
@@ -506,7 +509,9 @@ def run_log(imu: str | os.PathLike[str], out: str | os.PathLike[str], *, kind: I
             q0: ArrayLike | None = None, on_gap: RunGapPolicy = "report",
             gap_tolerance: float = 1.5, saturation: float | None = None,
             progress: bool = False, resample: bool = False,
-            accept_unit_warning: bool = False, delimiter: str | None = None) -> dict[str, Any]:
+            accept_unit_warning: bool = False, delimiter: str | None = None,
+            timing: TimingMode = "auto", jitter_tolerance: float = JITTER_TOLERANCE,
+            held: HeldPolicy = "auto", duplicates: DuplicatePolicy = "error") -> dict[str, Any]:
     """Process a log and write ``out`` with its metadata sidecar ``OUT.meta.json``.
 
     Returns the metadata (input, algorithm, initial attitude, samples, outputs, update and
@@ -515,6 +520,9 @@ def run_log(imu: str | os.PathLike[str], out: str | os.PathLike[str], *, kind: I
 
     Parameters
     ----------
+    kind : {"rate", "increment"} or None
+        None: what the CSV header's unit says (``gx[rad/s]``: rates, ``gx[rad]``:
+        increments; :func:`strapdown.io.readers.log_kind`), else an error.
     algorithm : str, optional
         Default: ``rate-three`` for rates, ``rotvec`` for increments.
     subsamples : int, optional
@@ -544,6 +552,11 @@ def run_log(imu: str | os.PathLike[str], out: str | os.PathLike[str], *, kind: I
         Run although magnitudes suggest another unit than declared (else an error).
     delimiter : str, optional
         A CSV's delimiter (default: detected from its header row).
+    timing, jitter_tolerance, held, duplicates
+        The time base (:func:`strapdown.io.read_imu`; :mod:`strapdown.io.timing`): by
+        default the samples lie on the sensor's clock fitted to the stamps, held rows are
+        collapsed when that clock confirms them, a duplicated stamp with different values
+        is an error. ``resample=True`` is ``timing="resample"``.
 
     Raises
     ------
@@ -560,6 +573,13 @@ def run_log(imu: str | os.PathLike[str], out: str | os.PathLike[str], *, kind: I
         raise InputError(f"angles must be ypr, cone or none, got {shown(angles, 20)}")
     if on_gap not in RUN_GAP_POLICIES:
         raise InputError(f"on_gap must be report, error or split, got {shown(on_gap, 20)}")
+    if kind is None:
+        kind = log_kind(imu_path, columns, delimiter=delimiter)
+        if kind is None:
+            raise InputError(f"{imu_path}: does the log hold rates or increments? Its header "
+                             "does not say (a unit such as gx[rad/s] or gx[rad] would); pass "
+                             "--rates or --increments")
+    resample = resample or timing == "resample"
     spec = _spec(kind, algorithm, structure, subsamples, coefficients)
     q_init = None if q0 is None else _unit_quaternion(q0)
     check_read_options(kind=kind, units=units, gap_tolerance=gap_tolerance, on_gap="report",
@@ -571,6 +591,14 @@ def run_log(imu: str | os.PathLike[str], out: str | os.PathLike[str], *, kind: I
             "gap_tolerance": gap_tolerance, "on_gap": "error" if on_gap == "error" else "report",
             "saturation": saturation, "unit_check": unit_action(accept_unit_warning),
             "delimiter": delimiter}
+    # the time base's options, when not the defaults (a log read with the defaults may
+    # stream: see _rate_scan)
+    for key, value, default in (("timing_mode", "auto" if timing == "resample" else timing,
+                                 "auto"), ("jitter_tolerance", jitter_tolerance,
+                                           JITTER_TOLERANCE), ("held", held, "auto"),
+                                ("duplicates", duplicates, "error")):
+        if value != default:
+            read[key] = value
     split = on_gap == "split"
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")

@@ -159,7 +159,8 @@ def log_args(p: argparse.ArgumentParser, *, imu_help: str, required: bool,
     """A gyro log: ``--imu``, ``--rates``/``--increments``, ``--units``, ``--columns`` and,
     with ``sample_rate``, ``--sample-rate-hz``.
 
-    ``required`` makes ``--imu`` and the kind mandatory (``run``); otherwise the log is
+    ``required`` makes ``--imu`` mandatory (``run``; the kind comes from the header's unit
+    when neither ``--rates`` nor ``--increments`` is given); otherwise the log is
     optional (``compare`` runs on a motion without one, and its ``--sample-rate-hz`` is the
     motion's, see :func:`motion_args`).
     """
@@ -167,9 +168,10 @@ def log_args(p: argparse.ArgumentParser, *, imu_help: str, required: bool,
 
     g = p.add_argument_group("gyro log")
     g.add_argument("--imu", required=required, help=imu_help)
-    kind = g.add_mutually_exclusive_group(required=required)
+    kind = g.add_mutually_exclusive_group()
     kind.add_argument("--rates", dest="kind", action="store_const", const="rate",
-                      help="the log holds angular rates")
+                      help="the log holds angular rates (default: what the header's unit "
+                      "says, gx[rad/s] rates, gx[rad] increments)")
     kind.add_argument("--increments", dest="kind", action="store_const", const="increment",
                       help="the log holds angular increments")
     g.add_argument("--units", default=None, choices=(*RATE_UNITS, *INCREMENT_UNITS),

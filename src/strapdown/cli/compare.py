@@ -4,7 +4,14 @@ from __future__ import annotations
 
 import argparse
 
-from strapdown.cli._common import columns, log_args, log_check_args, motion_args, say
+from strapdown.cli._common import (
+    columns,
+    log_args,
+    log_check_args,
+    motion_args,
+    say,
+    timing_options,
+)
 from strapdown.cli.evaluate import sculling_args
 
 __all__ = ["add_parser", "run"]
@@ -66,14 +73,19 @@ def run(args: argparse.Namespace) -> int:
             frequency_hz=args.frequency_hz, phase_deg=args.phase_deg)
         runs = compare.compare_motion(base, args.algorithms, args.out, progress=say)
     else:
-        if args.kind is None:
-            raise ValueError("--imu needs --rates or --increments")
+        from strapdown.io.readers import log_kind
+
+        cols = None if args.columns is None else columns(args.columns)
+        kind = args.kind or log_kind(args.imu, cols, delimiter=args.delimiter)
+        if kind is None:
+            raise ValueError("--imu needs --rates or --increments (its header does not say: "
+                             "a unit such as gx[rad/s] or gx[rad] would)")
         runs = compare.compare_log(
-            args.imu, args.algorithms, args.out, kind=args.kind, units=args.units,
-            columns=None if args.columns is None else columns(args.columns),
-            sample_rate_hz=args.sample_rate_hz, truth=args.truth, progress=say,
-            on_gap=args.on_gap, gap_tolerance=args.gap_tolerance, resample=args.resample,
-            accept_unit_warning=args.accept_unit_warning, delimiter=args.delimiter)
+            args.imu, args.algorithms, args.out, kind=kind, units=args.units,
+            columns=cols, sample_rate_hz=args.sample_rate_hz, truth=args.truth, progress=say,
+            on_gap=args.on_gap, gap_tolerance=args.gap_tolerance,
+            accept_unit_warning=args.accept_unit_warning, delimiter=args.delimiter,
+            **timing_options(args))
     for r in runs:
         if "velocity_error_rate_z_m_s2" in r.summary:
             ratio = r.summary["velocity_rate_over_law"]

@@ -15,6 +15,7 @@ from strapdown.cli._common import (
     progress_args,
     say,
     structure_help,
+    timing_options,
 )
 
 if TYPE_CHECKING:
@@ -96,8 +97,9 @@ def run(args: argparse.Namespace) -> int:
                   sample_rate_hz=args.sample_rate_hz, angles=args.angles, q0=q0,
                   on_gap=args.on_gap,
                   gap_tolerance=args.gap_tolerance, saturation=args.saturation,
-                  progress=progress(args), resample=args.resample,
-                  accept_unit_warning=args.accept_unit_warning, delimiter=args.delimiter)
+                  progress=progress(args),
+                  accept_unit_warning=args.accept_unit_warning, delimiter=args.delimiter,
+                  **timing_options(args))
     for w in res["warnings"]:
         say(f"warning: {w}")
     gaps, saturated = res["gaps"], res["saturated"]
