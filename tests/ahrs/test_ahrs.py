@@ -15,6 +15,7 @@ from strapdown.ahrs.filter import Q_NED_ENU, AhrsConfig, attitude_from_acc_mag, 
 from strapdown.analysis.broad import broad_errors
 from strapdown.rotation.dcm import dcm_from_quat
 from strapdown.rotation.error import attitude_error_angle
+from strapdown.rotation.euler import euler_zyx_from_dcm
 from strapdown.rotation.quaternion import quat_multiply
 from strapdown.truth.motions import SpinConing
 
@@ -463,7 +464,12 @@ def test_cli_ahrs_csv_roundtrip_and_degraded_mode(tmp_path, capsys):
     assert main(["ahrs", "--imu", str(tmp_path / "imu.csv"), "--gyro-units", "deg/s",
                  "--acc-units", "g", "--out", str(out)]) == 0
     a = np.genfromtxt(out, delimiter=",", names=True)
-    assert a.dtype.names == ("t", "qw", "qx", "qy", "qz", "bias_x", "bias_y", "bias_z")
+    assert a.dtype.names == ("t", "qw", "qx", "qy", "qz", "yaw_deg", "pitch_deg", "roll_deg",
+                             "bias_x", "bias_y", "bias_z")
+    y, p, r = euler_zyx_from_dcm(dcm_from_quat(np.column_stack([a["qw"], a["qx"], a["qy"],
+                                                                 a["qz"]])))
+    assert np.allclose(np.degrees([y, p, r]).T, np.column_stack(
+        [a["yaw_deg"], a["pitch_deg"], a["roll_deg"]]), atol=1e-9)
     assert a.size == t.size and a["t"][0] == t[0]  # one row per sample, the first at t[0]
     text = (tmp_path / "att.csv.meta.json").read_text()
     meta = json.loads(text, parse_constant=lambda c: pytest.fail(f"not JSON: {c}"))
