@@ -212,7 +212,9 @@ def _non_uniform(d: NDArray[np.float64], jitter: float, tolerance: float) -> Val
                       f"{float(d[row - 1]):.9g} s against the median {med:.9g} s; the time "
                       f"stamps stray up to {jitter:.3g} periods from a uniform grid (jitter "
                       f"tolerance {tolerance:g} period) — rate algorithms need uniform "
-                      "samples: split the log at gaps (--on-gap split)")
+                      "samples: fit the sensor's clock to the stamps "
+                      "(strapdown.io.timing.fit_clock; the commands' default --timing auto) or "
+                      "resample (resample=True)")
 
 
 def check_rate_record(t: ArrayLike, omega: ArrayLike, *, min_samples: int = 2,

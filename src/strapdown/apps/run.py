@@ -70,7 +70,13 @@ from strapdown.io.readers import (
     npy_log,
     warn_implausible_rate,
 )
-from strapdown.io.timing import JITTER_TOLERANCE, DuplicatePolicy, HeldPolicy, TimingMode
+from strapdown.io.timing import (
+    JITTER_TOLERANCE,
+    DuplicatePolicy,
+    HeldPolicy,
+    TimingMode,
+    uniform_timing_record,
+)
 from strapdown.rotation.cone_angles import cone_angles_from_quat
 from strapdown.rotation.dcm import dcm_from_quat, quat_from_dcm
 from strapdown.rotation.euler import dcm_from_euler_zyx, euler_zyx_from_dcm
@@ -435,9 +441,10 @@ def _run_rates_streamed(imu: Path, tmp: Path, scan: _RateScan, spec: AlgorithmSp
                 out.write(rows)
                 scan.motion.attitudes(res.q)
     base = JitterSummary(scan.td, float(np.float64(dev) / scan.td), False, 1)
+    timing = uniform_timing_record(scan.td, repr(float(scan.t0)))
     return {"samples": n, "outputs": out.rows, "gaps": [], "saturated": scan.saturated,
-            "units": scan.units, "columns": names, **base.to_dict(),
-            "time_base": base.describe(), "motion": scan.motion.to_dict(), "streamed": True}
+            "units": scan.units, "columns": names, **base.to_dict(), "timing": timing,
+            "time_base": timing["summary"], "motion": scan.motion.to_dict(), "streamed": True}
 
 
 class _Output:
@@ -637,7 +644,8 @@ def _metadata(imu: Path, spec: AlgorithmSpec, res: dict[str, Any], on_gap: str,
         "columns": res["columns"], "samples": res["samples"], "outputs": res["outputs"],
         "update_period_s": spec.update_period(h) if h else None, "sample_period_s": h,
         "jitter_periods": res.get("jitter_periods"), "resampled": res.get("resampled", False),
-        "time_base": res.get("time_base"), "on_gap": on_gap, "gaps": rows(res["gaps"]),
+        "time_base": res.get("time_base"), "timing": res.get("timing"), "on_gap": on_gap,
+        "gaps": rows(res["gaps"]),
         "segments": res["segments"], "saturation": saturation,
         "saturated": rows(res["saturated"]), **res["motion"],
         "total_rotation": "sum of the rotation angles between successive attitude outputs",
@@ -749,7 +757,8 @@ def _run_rates(imu: Path, tmp: Path, read: dict[str, Any], spec: AlgorithmSpec,
     extra = _angles(q, angles)
     if split:
         extra["segment"] = np.concatenate(segs)
-    write_attitude(tmp, t, q, extra=extra)
+    write_attitude(tmp, t, q, extra=extra,
+                   time_origin=None if log.timing is None else log.timing.base.origin_text)
     motion = _Motion()
     motion.rates(log.data)
     for sq in qs:  # each record starts where the previous ended: its first row repeats that

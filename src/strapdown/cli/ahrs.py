@@ -20,8 +20,12 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         description="Run the AHRS filter over a recording (BROAD .mat or CSV with "
         "t,gx,gy,gz,ax,ay,az[,mx,my,mz]) and write t,qw,qx,qy,qz (q_n_b) and the gyro bias, "
         "one row per input sample (the first: the initial attitude at the first time stamp), "
-        "plus OUT.meta.json. Without magnetometer columns heading is not observed (said on "
-        "stderr and in the metadata).")
+        "plus yaw/pitch/roll (deg, z-y-x) and OUT.meta.json (with the time base: the "
+        "sensor's clock fitted to the stamps, held and duplicated rows, gaps bridged). "
+        "Frames: q_n_b rotates body vectors into n = ENU (x east, y north, z up; --frame NED: "
+        "north, east, down), Hamilton product, scalar first; t is each sample's time on the "
+        "fitted clock, in the file's time base. Without magnetometer columns heading is not "
+        "observed (said on stderr and in the metadata).")
     p.set_defaults(handler=run)
     return p
 

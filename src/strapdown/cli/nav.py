@@ -26,7 +26,10 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         description="Validate a gyro and accelerometer log, navigate it from the initial "
         "position, velocity and attitude (coning and sculling compensated, NED on WGS-84) and "
         "write t,lat_deg,lon_deg,height_m,vn,ve,vd,qw,qx,qy,qz, one row per update, "
-        "atomically.")
+        "atomically, with OUT.meta.json (the time base: the sensor's clock fitted to the "
+        "stamps and its residuals). Frames: n = NED (north, east, down), q_n_b rotates body "
+        "vectors into it (Hamilton, scalar first); each increment's stamp is the end of its "
+        "interval, t of a row the end of its update.")
     p.set_defaults(handler=run)
     return p
 

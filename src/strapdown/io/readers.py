@@ -699,12 +699,14 @@ def _load(path: Path, columns, sample_rate_hz, delimiter) -> _Source:
     if suffix == ".npy":
         arr = npy_log(path)
         check_bytes(path, arr.shape[0] * 32, "the log as float64")
-        return _Source(np.asarray(arr[:, 0], float), np.asarray(arr[:, 1:], float))
+        with np.errstate(over="ignore"):  # float128 beyond float64: infinity, refused by row
+            return _Source(np.asarray(arr[:, 0], float), np.asarray(arr[:, 1:], float))
     if suffix == ".npz":
         z = read_npz(path, ["t", "gyro"])
         if "gyro" not in z.arrays or "t" not in z.arrays:
             raise InputError(f"{path}: .npz logs need arrays 't' and 'gyro'; found {z.found()}")
-        return _Source(z.arrays["t"].astype(float), z.arrays["gyro"].astype(float))
+        with np.errstate(over="ignore"):  # float128 beyond float64: refused by row
+            return _Source(z.arrays["t"].astype(float), z.arrays["gyro"].astype(float))
     if suffix == ".mat":
         return _load_mat(path, sample_rate_hz)
     raise InputError(f"{path}: unsupported format {shown(suffix, 20)} (use .csv, .npy, .npz, "

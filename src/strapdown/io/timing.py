@@ -80,6 +80,7 @@ __all__ = [
     "format_times",
     "reconstruct",
     "relative_times",
+    "uniform_timing_record",
 ]
 
 #: How a command takes a recording's time stamps: ``auto`` (the classification decides:
@@ -669,3 +670,17 @@ def reconstruct(path: object, base: TimeBase, values: NDArray[np.float64], *,
     tk = t[cleaning.keep]
     clock = fit_clock(tk, period=period, tick=base.tick, jitter_tolerance=jitter_tolerance)
     return Timing(base, cleaning, clock, mode, jitter_tolerance)
+
+
+def uniform_timing_record(period: float, origin_text: str) -> dict[str, Any]:
+    """:meth:`Timing.to_dict` of stamps found exactly uniform in a streamed pass (no row
+    dropped, no clock residual beyond :data:`UNIFORM_TOLERANCE`), without holding the ticks."""
+    clock = {"kind": "uniform", "period_s": period, "rate_hz": 1.0 / period,
+             "period_given": False, "offset_s": 0.0, "residual_rms_s": 0.0,
+             "residual_max_s": 0.0, "residual_p99_s": 0.0, "residual_max_periods": 0.0,
+             "stamp_tick_s": None, "drift_s": [], "collisions": 0, "missing_samples": 0,
+             "gaps": 0, "longest_gap_samples": 0}
+    summary = f"clock {1 / period:.6g} Hz fitted (uniform stamps)"
+    return {"mode": "auto", "jitter_tolerance_periods": JITTER_TOLERANCE,
+            "time_origin": origin_text, "stamp_tick_s": None, "clock": clock,
+            **RowCleaning(np.zeros(0, np.int64)).to_dict(), "summary": summary}
