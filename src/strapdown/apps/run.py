@@ -62,6 +62,7 @@ from strapdown.io.readers import (
     RATE_PLAUSIBLE_MAX,
     GapPolicy,
     GyroUnit,
+    check_distinct_columns,
     check_motion,
     check_read_options,
     check_steps,
@@ -580,6 +581,7 @@ def run_log(imu: str | os.PathLike[str], out: str | os.PathLike[str], *,
         raise InputError(f"angles must be ypr, cone or none, got {shown(angles, 20)}")
     if on_gap not in RUN_GAP_POLICIES:
         raise InputError(f"on_gap must be report, error or split, got {shown(on_gap, 20)}")
+    check_distinct_columns(columns)
     if kind is None:
         kind = log_kind(imu_path, columns, delimiter=delimiter)
         if kind is None:

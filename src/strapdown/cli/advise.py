@@ -86,13 +86,12 @@ def _spectrum(args: argparse.Namespace):
             raise ValueError("--psd needs --sample-rate-hz (the rate the algorithm runs at)")
         f, g = read_psd(args.psd, sample_rate_hz=args.sample_rate_hz)
         return f, g, 1.0 / args.sample_rate_hz, None, None, None
-    if args.kind is None:
-        raise ValueError("--imu needs --rates or --increments")
     if args.nperseg < 16:
         raise ValueError(f"--nperseg must be at least 16, got {args.nperseg}")
     from strapdown.io import read_imu
 
     cols = None if args.columns is None else columns(args.columns)
+    # kind None: read_imu takes it from the header's unit (gx[rad/s]), else asks for it
     with np.errstate(over="ignore", invalid="ignore"):  # values beyond float64 (a float128
         log = read_imu(args.imu, kind=args.kind, units=args.units,  # .npy) read as
                        columns=cols, sample_rate_hz=args.sample_rate_hz,  # infinity and are
