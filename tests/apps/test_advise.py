@@ -129,13 +129,15 @@ def test_cli_without_coning_recommends_the_cheapest(tmp_path, capsys):
     (["--psd", "{bad}"], "needs --sample-rate-hz"),
     (["--imu", "{missing}", "--increments"], "no such log file"),
     ([], "one of --imu LOG or --psd FILE"),
-    (["--imu", "{log}"], "--rates or --increments"),
+    (["--imu", "{plain}"], "--rates or --increments"),  # a header without units
 ])
 def test_cli_malformed_input(tmp_path, capsys, args, msg):
     bad = tmp_path / "bad.csv"
     bad.write_text("f_hz,im_gyz,im_gzx,im_gxy\n1,2,3\n")
     log = _log(tmp_path / "l.csv", True, n=200)
-    subst = {"bad": bad, "missing": tmp_path / "none.csv", "log": log}
+    plain = tmp_path / "plain.csv"
+    plain.write_text("t,gx,gy,gz\n" + "".join(f"{k * 0.01},0,0,0\n" for k in range(200)))
+    subst = {"bad": bad, "missing": tmp_path / "none.csv", "log": log, "plain": plain}
     with pytest.raises(SystemExit) as exc:
         main(["advise", *[a.format(**subst) for a in args], "--figure",
               str(tmp_path / "c.png")])
@@ -264,3 +266,11 @@ def test_cli_rejects_a_negative_verify(tmp_path, capsys):
               str(tmp_path / "x.png")])
     assert exc.value.code == 2
     assert "--verify must be ≥ 0" in capsys.readouterr().err
+
+
+def test_cli_takes_the_kind_from_the_header_unit(tmp_path, capsys):
+    """A log whose header says gx[rad] holds increments: no --increments needed."""
+    log = _log(tmp_path / "l.csv", True, n=2000)
+    assert main(["advise", "--imu", str(log), "--json", "--no-verify"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert all(c["spec"].startswith(("rotvec", "Protvec")) for c in out["candidates"])
