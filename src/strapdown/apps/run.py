@@ -448,6 +448,10 @@ def _run_rates_streamed(imu: Path, tmp: Path, scan: _RateScan, spec: AlgorithmSp
             "time_base": timing["summary"], "motion": scan.motion.to_dict(), "streamed": True}
 
 
+#: Rows formatted at once when writing CSV (a few hundred kB of text: no memory to speak of).
+_TEXT_BLOCK = 2048
+
+
 class _Output:
     """The attitude table written as it comes: CSV rows appended (``%.17g``, as
     :func:`strapdown.io.write_attitude`), ``.npz`` columns gathered and written at the end."""
@@ -466,9 +470,11 @@ class _Output:
 
     def write(self, rows: NDArray[np.float64]) -> None:
         self.rows += rows.shape[0]
-        if self.csv:  # savetxt's text, row by row on Python floats (15 % faster)
+        if self.csv:  # savetxt's text, on Python floats (15 % faster), in small blocks
             fmt = ",".join(["%.17g"] * rows.shape[1])
-            self._f.write("".join([fmt % tuple(r) + "\n" for r in rows.tolist()]))
+            for s in range(0, rows.shape[0], _TEXT_BLOCK):
+                self._f.write("".join([fmt % tuple(r) + "\n"
+                                       for r in rows[s:s + _TEXT_BLOCK].tolist()]))
         else:
             self._parts.append(rows)
 

@@ -1022,9 +1022,9 @@ def write_attitude(path: str | os.PathLike[str], t: ArrayLike, q: NDArray[np.flo
             fmt = ",".join(["%.17g"] * table.shape[1])
             with open(tmp, "w", encoding="utf-8") as f:
                 f.write(",".join(names) + "\n")
-                for start in range(0, table.shape[0], 1 << 16):
+                for start in range(0, table.shape[0], 2048):
                     f.write("".join([fmt % tuple(r) + "\n"
-                                     for r in table[start:start + (1 << 16)].tolist()]))
+                                     for r in table[start:start + 2048].tolist()]))
             return path
         assert time_origin is not None
         times = format_times(time_origin, table[:, 0] - float(time_origin), decimals=6)
