@@ -324,9 +324,9 @@ def coefficients_help(names: Iterable[AlgorithmName]) -> str:
 
     parts = []
     for ns, (choices, default) in _by_family(names, sets):
-        rest = [c for c in choices if c != default]
-        parts.append(f"{ns}: " + (f"{default} (default), {', '.join(rest)}" if choices
-                                  else "none"))
+        listed = [f"{c} (default)" if c == default else c
+                  for c in (default, *(c for c in choices if c != default)) if c]
+        parts.append(f"{ns}: " + (", ".join(listed) or "none"))
     return "; ".join(parts)
 
 

@@ -58,7 +58,7 @@ def run(args: argparse.Namespace) -> int:
         e = export_c(args.out, algorithm=args.algorithm, structure=args.structure,
                      subsamples=3 if args.subsamples is None else args.subsamples,
                      coefficients=args.coefficients, real=args.real, name=args.name)
-        print(f"wrote {args.out}/{e.name}.h and {e.name}.c")
+        print(_wrote(args.out, e.name))
         print("operations per update: " + ", ".join(f"{k} {v}" for k, v in e.ops.items()))
         return 0
     fam = family(args.algorithm)
@@ -80,6 +80,14 @@ def run(args: argparse.Namespace) -> int:
                  subsamples=3 if args.subsamples is None else args.subsamples,
                  coefficients=args.coefficients, real=args.real, name=args.name,
                  **({} if h is None else {"h": h}))
-    print(f"wrote {args.out}/{e.name}.h and {e.name}.c")
+    print(_wrote(args.out, e.name))
     print("operations per update: " + ", ".join(f"{k} {v}" for k, v in e.ops.items()))
     return 0
+
+
+def _wrote(out: str, name: str) -> str:
+    """``wrote DIR/NAME.h and DIR/NAME.c``: the paths as the files are, however ``--out``
+    was typed (``flight/`` gives ``flight/NAME.h``, not ``flight//NAME.h``)."""
+    from pathlib import Path
+
+    return f"wrote {Path(out) / f'{name}.h'} and {Path(out) / f'{name}.c'}"
