@@ -212,9 +212,10 @@ def _non_uniform(d: NDArray[np.float64], jitter: float, tolerance: float) -> Val
                       f"{float(d[row - 1]):.9g} s against the median {med:.9g} s; the time "
                       f"stamps stray up to {jitter:.3g} periods from a uniform grid (jitter "
                       f"tolerance {tolerance:g} period) — rate algorithms need uniform "
-                      "samples: fit the sensor's clock to the stamps "
-                      "(strapdown.io.timing.fit_clock; the commands' default --timing auto) or "
-                      "resample (resample=True)")
+                      "samples: put them on the sensor's clock, t = "
+                      "strapdown.io.timing.fit_clock(t - t[0]).uniform_times() + t[0], or "
+                      "interpolate them onto a uniform grid "
+                      "(strapdown.algorithms.rate.resample_uniform)")
 
 
 def check_rate_record(t: ArrayLike, omega: ArrayLike, *, min_samples: int = 2,

@@ -24,7 +24,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 from fractions import Fraction
-from typing import Literal, get_args
+from typing import TYPE_CHECKING, Literal, cast, get_args
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -46,6 +46,10 @@ from strapdown.algorithms.coning import (
 )
 from strapdown.algorithms.family import IncrementStructure
 from strapdown.algorithms.finite_amplitude import triple_terms
+
+if TYPE_CHECKING:  # the records the structures take, as AlgorithmSpec.run does
+    from strapdown.io.readers import ImuLog
+    from strapdown.truth.sensors import GyroRecord
 
 __all__ = [
     "STRUCTURES",
@@ -130,11 +134,11 @@ def _check_inputs(increments: ArrayLike, coefficients: CoefficientSet, h: float,
 
 
 def conventional(
-    increments: ArrayLike,
+    increments: ArrayLike | GyroRecord | ImuLog,
     coefficients: CoefficientSet,
     *,
-    h: float,
-    t0: float = 0.0,
+    h: float | None = None,
+    t0: float | None = None,
     q0: ArrayLike | None = None,
     tail: TailPolicy = "error",
 ) -> AttitudeSolution:
@@ -142,14 +146,16 @@ def conventional(
 
     Parameters
     ----------
-    increments : array_like of shape (n, 3)
-        Angular increments (rad) over consecutive intervals of length ``h``.
+    increments : array_like of shape (n, 3), GyroRecord or ImuLog
+        Angular increments (rad) over consecutive intervals of length ``h``; or an increment
+        record (:func:`strapdown.truth.sensors.increments`, :func:`strapdown.io.read_imu`),
+        which gives ``h`` and ``t0`` itself, as :meth:`AlgorithmSpec.run` takes it.
     coefficients : CoefficientSet
         Coning correction for N subsamples.
     h : float
-        Increment interval (s).
+        Increment interval (s); required with an array, the record's by default.
     t0 : float
-        Time of the first increment's start edge (s).
+        Time of the first increment's start edge (s); default 0, or the record's.
     q0 : array_like of shape (4,), optional
         Initial ``q_n_b`` (identity by default).
     tail : {"error", "drop"}
@@ -160,6 +166,7 @@ def conventional(
     AttitudeSolution
         ``n // N + 1`` outputs at ``t0 + j N h``.
     """
+    increments, h, t0 = _record_inputs(increments, h, t0, "conventional")
     theta, h, q0, t0 = _check_inputs(increments, coefficients, h, q0, t0)
     n = coefficients.n
     rest = theta.shape[0] % n
@@ -207,11 +214,11 @@ def stack_sets(sets: Sequence[CoefficientSet]) -> NDArray[np.float64]:
 
 
 def realtime(
-    increments: ArrayLike,
+    increments: ArrayLike | GyroRecord | ImuLog,
     coefficients: CoefficientSet,
     *,
-    h: float,
-    t0: float = 0.0,
+    h: float | None = None,
+    t0: float | None = None,
     q0: ArrayLike | None = None,
     startup: Sequence[CoefficientSet] | None = None,
 ) -> AttitudeSolution:
@@ -220,7 +227,7 @@ def realtime(
     Parameters
     ----------
     increments, coefficients, h, t0, q0
-        As for :func:`conventional`.
+        As for :func:`conventional` (an array with ``h``, or an increment record).
     startup : sequence of CoefficientSet, optional
         The k-subsample sets for the first ``N − 1`` outputs, ``k = 1 … N−1``
         (default: :func:`startup_sets`).
@@ -230,6 +237,7 @@ def realtime(
     AttitudeSolution
         ``n + 1`` outputs at ``t0 + k h``; output ``k`` belongs to chain ``k mod N``.
     """
+    increments, h, t0 = _record_inputs(increments, h, t0, "realtime")
     theta, h, q0, t0 = _check_inputs(increments, coefficients, h, q0, t0)
     n = coefficients.n
     if coefficients.triples:
@@ -250,9 +258,9 @@ def increment_structure(name: object) -> IncrementStructure:
     return name
 
 
-def run_structure(name: IncrementStructure, increments: ArrayLike,
-                  coefficients: CoefficientSet, *, h: float, t0: float = 0.0,
-                  q0: ArrayLike | None = None) -> AttitudeSolution:
+def run_structure(name: IncrementStructure, increments: ArrayLike | GyroRecord | ImuLog,
+                  coefficients: CoefficientSet, *, h: float | None = None,
+                  t0: float | None = None, q0: ArrayLike | None = None) -> AttitudeSolution:
     """Dispatch by structure name (``"conventional"``, ``"realtime"`` or ``"single-chain"``).
 
     The conventional structure drops a tail of fewer than N increments here
@@ -377,8 +385,9 @@ def single_chain_table(n: int) -> NDArray[np.float64]:
     return c
 
 
-def single_chain(increments: ArrayLike, n: int, *, h: float, t0: float = 0.0,
-                 q0: ArrayLike | None = None, triple: bool = False) -> AttitudeSolution:
+def single_chain(increments: ArrayLike | GyroRecord | ImuLog, n: int, *,
+                 h: float | None = None, t0: float | None = None, q0: ArrayLike | None = None,
+                 triple: bool = False) -> AttitudeSolution:
     """Single-chain high-rate structure: an attitude every h with N-subsample accuracy.
 
     ``φ_k = θ_k + Σ_{m=1}^{N−1} c_m θ_{k−m} × θ_k``, ``q_k = q_{k−1} ⊗ q(φ_k)``,
@@ -391,7 +400,11 @@ def single_chain(increments: ArrayLike, n: int, *, h: float, t0: float = 0.0,
     ``triple=True``: the finite-amplitude set, the same pairs plus
     ``Σ_m τ_m θ_k × (θ_{k−m} × θ_k)`` once N − 1 previous increments exist
     (:mod:`strapdown.algorithms.finite_amplitude`; the start-up is the plain one).
+
+    ``increments``, ``h`` and ``t0`` as for :func:`conventional`: an array with ``h``, or
+    an increment record that gives both.
     """
+    increments, h, t0 = _record_inputs(increments, h, t0, "single_chain")
     n = positive_int(n, "N (subsamples)")
     theta = np.ascontiguousarray(as_vectors(increments, "increments"))
     if theta.ndim != 2 or theta.shape[0] < 1:
@@ -414,6 +427,33 @@ def single_chain(increments: ArrayLike, n: int, *, h: float, t0: float = 0.0,
     t = t0 + np.arange(q.shape[0]) * h
     return AttitudeSolution(t, q, "single-chain", None, h, h, np.zeros(t.size, int),
                             min(n - 1, t.size - 1))
+
+
+def _record_inputs(increments: ArrayLike | GyroRecord | ImuLog, h: float | None,
+                   t0: float | None, name: str) -> tuple[ArrayLike, float, float]:
+    """``(increments, h, t0)`` of a structure call: an array with ``h`` (``t0`` default 0),
+    or a record with ``data``, ``kind``, ``h`` and ``t`` (a GyroRecord, an ImuLog) whose
+    own interval and start edge are used, as :meth:`AlgorithmSpec.run` does (``t`` one
+    entry longer than ``data``: the interval edges; as long: the interval ends). An ``h``
+    or ``t0`` given with a record must agree with it."""
+    data, kind = getattr(increments, "data", None), getattr(increments, "kind", None)
+    if data is None or kind is None:
+        if h is None:
+            raise ValueError(f"{name} needs h (the increment interval, s) with an array of "
+                             "increments; a GyroRecord or ImuLog carries its own")
+        return cast("ArrayLike", increments), h, 0.0 if t0 is None else t0
+    if kind != "increment":
+        raise ValueError(f"{name} takes angular increments; this record holds {kind}s (a rate "
+                         "record runs through AlgorithmSpec.run with a rate algorithm)")
+    data = np.asarray(data)
+    rh = float(getattr(increments, "h"))  # noqa: B009 (a record's, whatever its class)
+    t = np.asarray(getattr(increments, "t"), dtype=np.float64)  # noqa: B009
+    rt0 = float(t[0]) if t.shape[0] == data.shape[0] + 1 else float(t[0]) - rh
+    for what, given, own in (("h", h, rh), ("t0", t0, rt0)):
+        if given is not None and not np.isclose(given, own, rtol=1e-12, atol=0.0):
+            raise ValueError(f"{name}: {what} = {given!r} contradicts the record's {own!r} "
+                             f"(drop {what}=: a record carries its own)")
+    return data, rh, rt0
 
 
 def _stream_inputs(samples: ArrayLike, name: str, h: float, t0: float, q0: ArrayLike | None
