@@ -100,3 +100,71 @@ def test_structures_take_a_gyro_record_as_spec_run_does():
     rates = sensors.rate_samples(motion, h, 60)
     with pytest.raises(ValueError, match="takes angular increments; this record holds rates"):
         conventional(rates, table3)
+
+
+@pytest.mark.parametrize("command", ["run", "advise", "export-c", "sweep"])
+def test_a_bad_option_of_a_subcommand_prints_that_subcommands_usage(capsys, command):
+    with pytest.raises(SystemExit) as exc:
+        main([command, "--bogus", "1"])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"usage: strapdown {command} ")
+    # the subcommand's own line: unknown options when nothing is missing, else what is missing
+    assert f"strapdown {command}: error: " in err.splitlines()[-1]
+    with pytest.raises(SystemExit):
+        main(["evaluate", "--bogus", "1"])  # evaluate needs nothing: the unknown option named
+    err = capsys.readouterr().err
+    assert err.startswith("usage: strapdown evaluate ")
+    assert err.splitlines()[-1] == "strapdown evaluate: error: unrecognized arguments: --bogus 1"
+
+
+def test_every_long_command_takes_no_progress(tmp_path, capsys):
+    from strapdown.cli import build_parser
+
+    long = {"run": ["--imu", "x", "--out", "y"], "nav": ["--imu", "x", "--out", "y",
+            "--init-lat", "0", "--init-lon", "0", "--init-height", "0"],
+            "sweep": ["s.toml", "--out", "o"], "reproduce": ["li2017", "--out", "o"],
+            "bench": [], "benchmark-ahrs": ["d", "--out", "o"],
+            "ahrs": ["--imu", "x", "--out", "y"], "compare": ["--algorithms", "rk4", "--out", "o"],
+            "advise": ["--imu", "x"]}
+    for command, args in long.items():
+        for flag, shown in (("--no-progress", False), ("--progress", True)):
+            assert build_parser().parse_args([command, *args, flag]).progress is shown, command
+    # compare: a line per algorithm with --progress, none with --no-progress or by default
+    # (captured stderr is no terminal); the results on stdout either way
+    cmp = ["compare", "--algorithms", "rotvec:N=2", "rk4", "--sample-rate-hz", "600",
+           "--duration", "0.5", "--out", str(tmp_path / "c")]
+    assert main([*cmp, "--progress"]) == 0
+    shown = capsys.readouterr()
+    assert "[1/2] rotvec:N=2" in shown.err and "[2/2] rk4" in shown.err
+    for quiet in (["--no-progress"], []):
+        assert main([*cmp, *quiet]) == 0
+        got = capsys.readouterr()
+        assert got.err == "" and got.out == shown.out
+
+
+def _psd(path):
+    f = np.arange(0.0, 60.5, 1.0)
+    im = np.where(f == 20.0, -1e-3, 0.0)
+    path.write_text("f_hz,im_gyz,im_gzx,im_gxy\n" + "\n".join(
+        f"{a},{b},0,0" for a, b in zip(f, im, strict=True)) + "\n")
+    return str(path)
+
+
+def test_advise_json_writes_no_figure_unless_asked(tmp_path, monkeypatch, capsys):
+    import json
+
+    psd = _psd(tmp_path / "psd.csv")
+    work = tmp_path / "work"
+    work.mkdir()
+    monkeypatch.chdir(work)
+    args = ["advise", "--psd", psd, "--sample-rate-hz", "400", "--budget-deg-h", "0.05"]
+    assert main([*args, "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["recommended"]
+    assert list(work.iterdir()) == []  # before: advise.png in the current directory
+    assert main([*args, "--json", "--figure", "fig.png"]) == 0  # asked for: written
+    assert [p.name for p in work.iterdir()] == ["fig.png"]
+    (work / "fig.png").unlink()
+    assert main(args) == 0  # the table: its figure by default, and says where
+    assert [p.name for p in work.iterdir()] == ["advise.png"]
+    assert "figure: advise.png" in capsys.readouterr().err

@@ -93,8 +93,17 @@ class CommandParser(Parser):
         return self
 
     def parse_known_args(self, args=None, namespace=None):
+        """Parse this subcommand's options; an unknown one is this subcommand's error.
+
+        argparse hands a subparser's leftovers to the top-level parser, which would print
+        ``strapdown``'s usage for ``strapdown run --bogus``; nothing can follow a
+        subcommand's arguments, so leftovers are refused here, with this command's usage.
+        """
         self.populate()
-        return super().parse_known_args(args, namespace)
+        namespace, extras = super().parse_known_args(args, namespace)
+        if extras:
+            self.error(f"unrecognized arguments: {' '.join(extras)}")
+        return namespace, extras
 
     def format_usage(self) -> str:
         self.populate()

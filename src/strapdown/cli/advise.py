@@ -4,7 +4,15 @@ from __future__ import annotations
 
 import argparse
 
-from strapdown.cli._common import columns, json_arg, log_args, print_json, say
+from strapdown.cli._common import (
+    columns,
+    json_arg,
+    log_args,
+    print_json,
+    progress,
+    progress_args,
+    say,
+)
 
 __all__ = ["add_parser", "run"]
 
@@ -18,10 +26,10 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         "read it from a file, predict each candidate algorithm's drift by summing its exact "
         "coning response over the spectrum, count its operations per second in the C export, "
         "and name the cheapest one within the drift budget (with no coning content: the "
-        "cheapest). Prints a table, writes a figure of drift against cost with the Pareto "
-        "front, or --json: {candidates: [{spec, predicted_drift_deg_h, measured_drift_deg_h, "
-        "ops_per_s}], recommended}. With --imu the cheapest candidates are verified on the "
-        "log itself (--verify).")
+        "cheapest). Prints a table and writes a figure of drift against cost with the Pareto "
+        "front (--figure), or --json: {candidates: [{spec, predicted_drift_deg_h, "
+        "measured_drift_deg_h, ops_per_s}], recommended} and no figure unless --figure is "
+        "given. With --imu the cheapest candidates are verified on the log itself (--verify).")
     p.set_defaults(handler=run)
     return p
 
@@ -49,9 +57,11 @@ def _arguments(p: argparse.ArgumentParser) -> None:
                    "cheapest whose measured drift meets the budget too (default: 8; 0 = off)")
     g.add_argument("--no-verify", dest="verify", action="store_const", const=0,
                    help="rank by the spectral prediction alone (same as --verify 0)")
-    g.add_argument("--figure", default="advise.png",
-                   help="figure of predicted drift against cost (default: advise.png)")
+    g.add_argument("--figure", default=None,
+                   help="figure of predicted drift against cost (default: advise.png; with "
+                   "--json none unless given)")
     json_arg(p)
+    progress_args(p, "a line as each stage starts and each candidate is verified")
 
 
 def _ops_per_s(spec, h: float) -> float:
@@ -118,14 +128,28 @@ def run(args: argparse.Namespace) -> int:
         write_figure,
     )
 
+    stage = say if progress(args) else (lambda _line: None)
+    figure = args.figure if args.figure is not None or args.json else "advise.png"
+    stage(f"spectrum of {args.imu or args.psd}")
     f, g, h, segments, kind, log = _spectrum(args)
+    if log is not None and args.verify > 0:
+        stage("band-limited reference attitude of the log")
     ref = log_reference(log) if log is not None and args.verify > 0 else None
-    measure = None if ref is None else (lambda spec: verified_drift_deg_h(spec, log, ref))
-    adv = advise(f, g, h, candidate_specs(kind), _ops_per_s, budget_deg_h=args.budget_deg_h,
-                 max_ops=args.max_ops, segments=segments, measure=measure,
+
+    def measure(spec) -> float:
+        assert ref is not None  # measure is passed only with a reference
+        stage(f"verifying {spec} on the log")
+        return verified_drift_deg_h(spec, log, ref)
+
+    specs = candidate_specs(kind)
+    stage(f"ranking {len(specs)} candidates (predicted drift, operations per second)")
+    adv = advise(f, g, h, specs, _ops_per_s, budget_deg_h=args.budget_deg_h,
+                 max_ops=args.max_ops, segments=segments,
+                 measure=None if ref is None else measure,
                  unresolved=0.0 if log is None else unresolved_fraction(log, f, g),
                  verify=args.verify, accuracy_deg_h=0.0 if ref is None else ref.accuracy_deg_h)
-    write_figure(adv, args.figure)
+    if figure is not None:
+        write_figure(adv, figure)
     reference = None if ref is None else {
         "upsample": ref.upsample, "accuracy_deg_h": ref.accuracy_deg_h,
         "window_s": list(ref.window), "segments": segments}
@@ -133,7 +157,7 @@ def run(args: argparse.Namespace) -> int:
         print_json({**adv.to_dict(), "reference": reference})
         return 0
     print("\n".join(_table(adv, ref)))
-    say(f"figure: {args.figure}")
+    say(f"figure: {figure}")
     return 0
 
 

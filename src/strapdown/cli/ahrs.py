@@ -3,8 +3,17 @@
 from __future__ import annotations
 
 import argparse
+import time
 
-from strapdown.cli._common import columns, input_args, log_check_args, say, timing_options
+from strapdown.cli._common import (
+    columns,
+    input_args,
+    log_check_args,
+    progress,
+    progress_args,
+    say,
+    timing_options,
+)
 
 __all__ = ["MAX_DECLINATION_DEG", "add_parser", "run"]
 
@@ -74,6 +83,7 @@ def _arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--declination-deg", type=float, default=0.0,
                    help="magnetic declination (deg, east positive, within ±180); 0 gives a "
                    "magnetic-north heading")
+    progress_args(p, "a line as the filter starts and ends")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -87,6 +97,11 @@ def run(args: argparse.Namespace) -> int:
                          f"positive), got {args.declination_deg:g}")
     cfg = AhrsConfig(gating=not args.no_gating, declination_deg=args.declination_deg,
                      gyro_sample=args.gyro_sample)
+    show = progress(args)
+    if show:
+        say(f"filtering {args.imu} ({args.algorithm}"
+            f"{', forward and backward' if args.offline else ''})…")
+        start = time.perf_counter()
     res, meta = run_ahrs(args.imu, args.out, algorithm=args.algorithm, frame=args.frame,
                          config=cfg, gyro_units=args.gyro_units, acc_units=args.acc_units,
                          columns=None if args.columns is None else columns(args.columns),
@@ -94,6 +109,8 @@ def run(args: argparse.Namespace) -> int:
                          on_gap=args.on_gap, gap_tolerance=args.gap_tolerance,
                          accept_unit_warning=args.accept_unit_warning,
                          delimiter=args.delimiter, offline=args.offline, **timing_options(args))
+    if show:
+        say(f"filtered {meta['outputs']} samples in {time.perf_counter() - start:.1f} s")
     for w in meta["warnings"]:
         say(f"warning: {w}")
     if meta["gaps"]["count"]:

@@ -9,6 +9,8 @@ from strapdown.cli._common import (
     log_args,
     log_check_args,
     motion_args,
+    progress,
+    progress_args,
     say,
     timing_options,
 )
@@ -46,6 +48,8 @@ def _arguments(p: argparse.ArgumentParser) -> None:
     log_check_args(p, saturation=False)
     p.add_argument("--truth", default=None,
                    help="log only: reference attitude file with t,qw,qx,qy,qz (CSV or .npz)")
+    progress_args(p, "a line as each algorithm runs, the log's time base and the files "
+                  "written")
     p.add_argument("--out", required=True, help="output directory")
 
 
@@ -53,6 +57,7 @@ def run(args: argparse.Namespace) -> int:
     """Compare the specs and print each one's maximum and RMS error."""
     from strapdown.apps import compare
 
+    lines = say if progress(args) else None
     if args.imu is None:
         log_only = (args.kind or args.truth or args.units or args.columns or args.resample
                     or args.delimiter
@@ -71,7 +76,7 @@ def run(args: argparse.Namespace) -> int:
             krylov_rates=tuple(args.krylov_rates),
             angle_amplitude_deg=args.angle_amplitude_deg, accel_amplitude=args.accel_amplitude,
             frequency_hz=args.frequency_hz, phase_deg=args.phase_deg)
-        runs = compare.compare_motion(base, args.algorithms, args.out, progress=say)
+        runs = compare.compare_motion(base, args.algorithms, args.out, progress=lines)
     else:
         from strapdown.io.readers import log_kind
 
@@ -82,7 +87,7 @@ def run(args: argparse.Namespace) -> int:
                              "a unit such as gx[rad/s] or gx[rad] would)")
         runs = compare.compare_log(
             args.imu, args.algorithms, args.out, kind=kind, units=args.units,
-            columns=cols, sample_rate_hz=args.sample_rate_hz, truth=args.truth, progress=say,
+            columns=cols, sample_rate_hz=args.sample_rate_hz, truth=args.truth, progress=lines,
             on_gap=args.on_gap, gap_tolerance=args.gap_tolerance,
             accept_unit_warning=args.accept_unit_warning, delimiter=args.delimiter,
             **timing_options(args))
