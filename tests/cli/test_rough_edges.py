@@ -168,3 +168,53 @@ def test_advise_json_writes_no_figure_unless_asked(tmp_path, monkeypatch, capsys
     assert main(args) == 0  # the table: its figure by default, and says where
     assert [p.name for p in work.iterdir()] == ["advise.png"]
     assert "figure: advise.png" in capsys.readouterr().err
+
+
+SCENARIO = ('algorithms = ["rotvec:N=2", "rk4"]\n[sensor]\nsample_rate_hz = 600.0\n'
+            'duration = 0.5\n[grid]\ncone_rate_hz = [1.0, 2.0]\n')
+
+
+def test_sweep_defaults_run_on_the_core_install(tmp_path, monkeypatch, capsys):
+    """Without pyarrow (not in the core install) the default writes the CSV table and says
+    how to get Parquet; asking for Parquet is refused, nothing written."""
+    monkeypatch.setitem(__import__("sys").modules, "pyarrow", None)  # import pyarrow fails
+    scn = tmp_path / "scn.toml"
+    scn.write_text(SCENARIO)
+    out = tmp_path / "sweep"
+    assert main(["sweep", str(scn), "--out", f"{out}/", "--workers", "1"]) == 0
+    got = capsys.readouterr()
+    assert sorted(p.name for p in out.iterdir()) == ["cases", "results.csv"]
+    assert "results.parquet" not in got.out and "strapdown[parquet]" in got.err
+    code, err = _exit(capsys, "sweep", str(scn), "--out", str(tmp_path / "pq"),
+                      "--format", "csv,parquet", "--workers", "1")
+    assert code == 2 and "needs pyarrow" in err and not (tmp_path / "pq").exists()
+
+
+def _exit(capsys, *args) -> tuple[int, str]:
+    with pytest.raises(SystemExit) as exc:
+        main(list(args))
+    return exc.value.code, capsys.readouterr().err
+
+
+def test_a_failed_dask_sweep_leaves_nothing_behind(tmp_path, monkeypatch, capsys):
+    """Status 2 promises nothing written: no empty cases/ (nor OUT) after a Dask sweep that
+    could not start — dask not installed, or no scheduler at the address."""
+    import sys
+
+    scn = tmp_path / "scn.toml"
+    scn.write_text(SCENARIO)
+    dask = ["--scheduler", "dask://127.0.0.1:9", "--format", "csv"]
+    monkeypatch.setitem(sys.modules, "distributed", None)  # the core install: no dask
+    code, err = _exit(capsys, "sweep", str(scn), "--out", str(tmp_path / "a"), *dask)
+    assert code == 2 and "strapdown[dask]" in err and not (tmp_path / "a").exists()
+    monkeypatch.delitem(sys.modules, "distributed")
+    distributed = pytest.importorskip("distributed")
+
+    def unreachable(address, timeout=None):
+        raise OSError(f"Timed out trying to connect to {address}")
+
+    monkeypatch.setattr(distributed, "Client", unreachable)
+    (tmp_path / "b").mkdir()  # an existing, empty OUT stays as it was
+    code, err = _exit(capsys, "sweep", str(scn), "--out", str(tmp_path / "b"), *dask)
+    assert code == 2 and "cannot reach the Dask scheduler" in err
+    assert list((tmp_path / "b").iterdir()) == []

@@ -35,8 +35,9 @@ stale result. Cases with the same configuration — a repeated grid value, or a 
 the algorithm spec sets itself (``subsamples`` under ``rotvec:N=3``) — are computed once and
 each labelled with its own grid point. When every case is done the tidy table — one row per
 case: ``case``, the grid parameters, ``algorithm``, the metrics — is written as
-``results.csv`` and ``results.parquet`` (pyarrow; the ``parquet`` extra), the Parquet table
-built before anything is written.
+``results.csv`` and, when pyarrow is installed (the ``parquet`` extra) or Parquet is asked
+for, ``results.parquet`` (:func:`default_formats`), the Parquet table built before anything
+is written.
 
 Every value of a scenario is checked for what its field takes, and every configuration
 before the first case runs (:func:`load_scenario`); anything wrong is an
@@ -89,7 +90,8 @@ from strapdown.io.files import atomic_path, csv_table, write_text
 from strapdown.truth.sensors import GyroErrors
 
 __all__ = ["FORMATS", "Case", "Scenario", "SweepInterrupted", "SweepResult", "TableFormat",
-           "case_metrics", "case_row", "cases", "load_scenario", "run_case", "sweep"]
+           "case_metrics", "case_row", "cases", "default_formats", "load_scenario", "run_case",
+           "sweep"]
 
 # The metric names a scenario may ask for are the evaluation's (METRICS, MetricName: keys of
 # Evaluation.to_dict), defined in strapdown.analysis.evaluate.
@@ -100,9 +102,19 @@ SCULLING_DEFAULT_METRICS: tuple[MetricName, ...] = (
     "velocity_error_rate_m_s2", "predicted_velocity_error_rate_m_s2", "velocity_rate_over_law")
 #: Added to a table that has the law's drift: the ratio and its meaning (analysis.law).
 LAW_COLUMNS: tuple[MetricName, ...] = ("measured_over_law", "law_status")
-#: The table formats a finished sweep writes.
+#: The table formats a finished sweep can write.
 TableFormat = Literal["csv", "parquet"]
 FORMATS: tuple[TableFormat, ...] = get_args(TableFormat)
+
+
+def default_formats() -> tuple[TableFormat, ...]:
+    """The tables a sweep writes unless told: CSV always, Parquet too when pyarrow is
+    installed (the ``parquet`` extra), so the core install runs a sweep as documented."""
+    try:
+        import pyarrow  # noqa: F401
+    except ImportError:
+        return ("csv",)
+    return FORMATS
 _CONFIG_FIELDS = {f.name for f in dataclasses.fields(EvaluationConfig)} - {"gyro", "seed"}
 _GYRO_FIELDS = {f.name for f in dataclasses.fields(GyroErrors)}
 _SECTIONS = ("motion", "sensor", "run")
@@ -502,7 +514,7 @@ def _parse_scheduler(scheduler: str) -> tuple[Literal["local", "dask"], str | No
 
 def sweep(scenario: str | os.PathLike[str] | Scenario, out: str | os.PathLike[str], *,
           scheduler: str = "local", workers: int | None = None,
-          formats: Iterable[TableFormat] = FORMATS, max_cases: int | None = None,
+          formats: Iterable[TableFormat] | None = None, max_cases: int | None = None,
           progress: bool = False, log: Callable[[str], None] | None = None) -> SweepResult:
     """Run (or finish) a scenario's grid; see the module docstring.
 
@@ -516,7 +528,9 @@ def sweep(scenario: str | os.PathLike[str] | Scenario, out: str | os.PathLike[st
         not a Literal, because of the address.
     workers : int, optional
         Local pool size (default: CPU count); 1 runs in this process.
-    formats : subset of {"csv", "parquet"}
+    formats : subset of {"csv", "parquet"}, optional
+        The tables written; default :func:`default_formats` (CSV, and Parquet when pyarrow
+        is installed). Asking for Parquet without pyarrow is an InputError.
     max_cases : int, optional
         Compute at most this many new cases, then stop (the table is written
         only when the grid is complete).
@@ -536,7 +550,8 @@ def sweep(scenario: str | os.PathLike[str] | Scenario, out: str | os.PathLike[st
     the first finished case) are removed again.
     """
     kind, address = _parse_scheduler(scheduler)
-    formats = _check_options(tuple(formats), workers, max_cases)
+    formats = _check_options(default_formats() if formats is None else tuple(formats),
+                             workers, max_cases)
     scn = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
     out = Path(out)
     if out.exists() and not out.is_dir():

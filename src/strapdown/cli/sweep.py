@@ -21,8 +21,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         "sweep", arguments=_arguments,
         help="run a TOML scenario's parameter grid (resumable)",
         description="Run every case of a scenario file's grid; each finished case is saved at "
-        "once, so an interrupted sweep resumes where it stopped. Writes OUT/results.csv and "
-        "OUT/results.parquet when the grid is complete. Exit status: 0 complete, "
+        "once, so an interrupted sweep resumes where it stopped. Writes OUT/results.csv (and "
+        "OUT/results.parquet when pyarrow is installed) when the grid is complete. Exit "
+        "status: 0 complete, "
         f"{INCOMPLETE} when --max-cases stops it first, {INTERRUPTED} on Ctrl-C (one line "
         "says how many cases are saved; rerun the same command to resume), 2 bad input. "
         "A scenario with motion = \"sculling\" (angle_amplitude_deg, accel_amplitude, "
@@ -41,8 +42,9 @@ def _arguments(p: argparse.ArgumentParser) -> None:
                    help="local (process pool) or dask://HOST:PORT")
     p.add_argument("--workers", type=int, default=None,
                    help="local pool size (default: CPU count; 1 runs in this process)")
-    p.add_argument("--format", default="csv,parquet",
-                   help="table formats, comma-separated: csv, parquet")
+    p.add_argument("--format", default=None,
+                   help="table formats, comma-separated: csv, parquet (default: csv, plus "
+                   "parquet when pyarrow is installed: pip install 'strapdown[parquet]')")
     p.add_argument("--max-cases", type=int, default=None,
                    help="compute at most this many new cases, then stop")
     input_args(p, delimiter=False)
@@ -58,11 +60,15 @@ def run(args: argparse.Namespace) -> int:
     from strapdown.apps.sweep import sweep
 
     res = sweep(args.scenario, args.out, scheduler=args.scheduler, workers=args.workers,
-                formats=[f.strip() for f in args.format.split(",") if f.strip()],
+                formats=None if args.format is None
+                else [f.strip() for f in args.format.split(",") if f.strip()],
                 max_cases=args.max_cases, progress=progress(args), log=say)
     if not res.complete:
         print(f"{res.skipped + res.computed} of {res.total} cases done; rerun to finish")
         return INCOMPLETE
     print(f"wrote {res.csv}" + (f" and {res.parquet}" if res.parquet else "")
           + f" ({res.total} cases, {res.skipped} reused)")
+    if args.format is None and res.parquet is None:
+        say("note: no results.parquet: pyarrow is not installed (pip install "
+            "'strapdown[parquet]', or --format csv to say CSV is all you want)")
     return 0
