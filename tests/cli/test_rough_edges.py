@@ -218,3 +218,23 @@ def test_a_failed_dask_sweep_leaves_nothing_behind(tmp_path, monkeypatch, capsys
     code, err = _exit(capsys, "sweep", str(scn), "--out", str(tmp_path / "b"), *dask)
     assert code == 2 and "cannot reach the Dask scheduler" in err
     assert list((tmp_path / "b").iterdir()) == []
+
+
+def test_broad_path_messages_name_strapdown_broad(tmp_path, monkeypatch, capsys):
+    """The README's BROAD commands with $STRAPDOWN_BROAD unset ("" and "/01_….mat"), a
+    wrong folder and an empty one: each refusal says which variable names the trials."""
+    monkeypatch.delenv("STRAPDOWN_BROAD", raising=False)
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    for args in (["benchmark-ahrs", "", "--out", str(tmp_path / "r")],
+                 ["benchmark-ahrs", str(tmp_path / "nowhere"), "--out", str(tmp_path / "r")],
+                 ["benchmark-ahrs", str(empty), "--out", str(tmp_path / "r")],
+                 ["ahrs", "--imu", "/01_undisturbed_slow_rotation_A.mat",
+                  "--out", str(tmp_path / "b.csv")]):
+        code, err = _exit(capsys, *args)
+        assert code == 2, err
+        assert "export STRAPDOWN_BROAD=" in err and "not set here" in err, err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["empty"]  # nothing written
+    monkeypatch.setenv("STRAPDOWN_BROAD", str(empty))
+    code, err = _exit(capsys, "benchmark-ahrs", str(empty), "--out", str(tmp_path / "r"))
+    assert "no BROAD trials (*.mat); " in err and repr(str(empty)) in err

@@ -281,12 +281,16 @@ def benchmark(directory: str | os.PathLike[str], out: str | os.PathLike[str], *,
     """Run every filter on every trial; returns ``{(trial, filter): errors}`` (the keys of
     :func:`strapdown.analysis.broad.broad_errors`, plus ``samples_per_s``) and writes the
     report to ``out``."""
+    from strapdown.io.broad import broad_hint
+
+    if not str(directory):  # "$STRAPDOWN_BROAD" with the variable unset
+        raise ValueError(f"no directory of BROAD trials given; {broad_hint()}")
     directory = Path(directory)
     if not directory.is_dir():
-        raise ValueError(f"{directory}: not a directory")
+        raise ValueError(f"{directory}: not a directory; {broad_hint()}")
     files = sorted(directory.glob("*.mat"))
     if not files:
-        raise ValueError(f"{directory}: no BROAD trials (*.mat)")
+        raise ValueError(f"{directory}: no BROAD trials (*.mat); {broad_hint()}")
     rep = Report.begin(out, progress)
     missing = {f: why for f in FILTERS if (why := _available(f))}
     ran = [f for f in FILTERS if f not in missing]

@@ -92,6 +92,7 @@ def run(args: argparse.Namespace) -> int:
     from strapdown.ahrs import AhrsConfig
     from strapdown.apps.ahrs_log import run_ahrs
 
+    _missing_broad_trial(args.imu)
     if not abs(args.declination_deg) <= MAX_DECLINATION_DEG:
         raise InputError(f"--declination-deg must lie within ±{MAX_DECLINATION_DEG:g}° (east "
                          f"positive), got {args.declination_deg:g}")
@@ -126,3 +127,18 @@ def run(args: argparse.Namespace) -> int:
           f"accelerometer used {meta['accelerometer_used']:.0%}, magnetometer "
           f"{meta['magnetometer_used']:.0%}; {meta['time_base']}) and {args.out}.meta.json")
     return 0
+
+
+def _missing_broad_trial(imu: str) -> None:
+    """A BROAD trial's name (``NN_*.mat``) that is not there: say where the trials are
+    looked for ($STRAPDOWN_BROAD; the README's ``"$STRAPDOWN_BROAD/01_….mat"`` with the
+    variable unset is ``/01_….mat``)."""
+    import os
+    import re
+
+    from strapdown._core.errors import InputError
+
+    if re.fullmatch(r"\d\d_\w+\.mat", os.path.basename(imu)) and not os.path.exists(imu):
+        from strapdown.io.broad import broad_hint
+
+        raise InputError(f"{imu}: no such recording; {broad_hint()}")

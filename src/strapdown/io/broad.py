@@ -19,7 +19,10 @@ from numpy.typing import NDArray
 from strapdown._core.errors import InputError
 from strapdown.io.containers import read_mat
 
-__all__ = ["BroadTrial", "read_broad"]
+__all__ = ["ENV", "BroadTrial", "broad_hint", "read_broad"]
+
+#: The environment variable naming the folder of BROAD trials (README, the test suite).
+ENV = "STRAPDOWN_BROAD"
 
 
 @dataclass(frozen=True)
@@ -37,6 +40,16 @@ class BroadTrial:
     @property
     def h(self) -> float:
         return float(self.t[1] - self.t[0])
+
+
+def broad_hint() -> str:
+    """What to say after a BROAD path that is not there: where the trials are looked for
+    (:data:`ENV`) and what it holds in this environment."""
+    value = os.environ.get(ENV)
+    now = ("it is not set here" if value is None else "it is empty here" if not value
+           else f"it is {value!r} here")
+    return (f"the BROAD trials (NN_*.mat) are the folder ${ENV} names: export {ENV}="
+            f"/path/to/broad ({now})")
 
 
 def read_broad(path: str | os.PathLike[str]) -> BroadTrial:
