@@ -6,7 +6,7 @@ STAMP  := $(VENV)/.installed
 DEVSTAMP := $(VENV)/.installed-dev
 DEMO_OUT ?= reports/li2017
 
-.PHONY: demo test bench lint fuzz clean
+.PHONY: demo test bench lint fuzz clean docs
 
 $(PY):
 	$(PYTHON) -m venv $(VENV)
@@ -37,6 +37,17 @@ fuzz: $(DEVSTAMP)
 	$(PY) tests/fuzz/campaign.py --profile long
 	STRAPDOWN_FUZZ_EXAMPLES=2000 $(PY) -m pytest -q -p no:cacheprovider tests/fuzz/test_fuzz_files.py -k "not campaign"
 
+## docs: the reference site into site/ (mkdocs.yml): API from the docstrings, the command line,
+## the pages of docs/, the examples gallery and the quick reproductions run at build time;
+## every warning (a broken link, anchor or reference) is an error
+DOCSSTAMP := $(VENV)/.installed-docs
+$(DOCSSTAMP): pyproject.toml | $(PY)
+	$(PY) -m pip install --quiet -e ".[docs]"
+	touch $@ $(STAMP)
+
+docs: $(DOCSSTAMP)
+	NO_MKDOCS_2_WARNING=1 $(VENV)/bin/mkdocs build --strict
+
 ## bench: throughput benchmarks with peers (numbers are reported, never asserted)
 bench: $(STAMP)
 	$(PY) -m pip install --quiet -e ".[bench]"
@@ -49,4 +60,4 @@ lint: $(DEVSTAMP)
 	$(VENV)/bin/mypy
 
 clean:
-	rm -rf $(VENV) build reports .pytest_cache
+	rm -rf $(VENV) build reports .pytest_cache site
