@@ -197,6 +197,8 @@ def body_increments(gyro: ArrayLike, accel: ArrayLike, n: int, *, h: float,
         False drops the sculling pair terms (rotation compensation only), to show their
         effect; the coning correction stays.
 
+    Notes
+    -----
     The conventional structure drops a tail of fewer than N samples.
     """
     g, a = _inputs(gyro, accel)
@@ -402,6 +404,8 @@ def integrate_inertial_rates(omega: ArrayLike, force: ArrayLike, *, td: float,
         the three-period pair coefficients on ω, f at 0, td, 2td, 3td, an update every 3 td
         (k ≥ 4; a tail of fewer than three intervals is dropped). Module docstring.
 
+    Notes
+    -----
     The solution's ``structure`` is ``"single-chain"`` for rate-single (an update every
     sample interval, ``n`` 1) and ``"conventional"`` for rate-three (``n`` 3).
     """

@@ -447,9 +447,12 @@ def navigate_log(imu: str | os.PathLike[str], out: str | os.PathLike[str], *, la
     on_gap, timing, jitter_tolerance, held, duplicates
         The gap policy and the time base (:func:`read_nav_log`).
 
-    Returns a summary (also written beside ``out`` as ``OUT.meta.json``): samples,
-    outputs, sample period, units, the time base (the fitted clock and its residuals),
-    bridged samples, warnings.
+    Returns
+    -------
+    dict
+        A summary (also written beside ``out`` as ``OUT.meta.json``): samples,
+        outputs, sample period, units, the time base (the fitted clock and its residuals),
+        bridged samples, warnings.
     """
     imu_path, out_path = Path(imu), Path(out)
     _check_out(imu_path, out_path)

@@ -731,6 +731,8 @@ def derive(structure: Structure, *, target: DesignTarget = "coning",
         (True, correct) or ignore it as a derivation that fits only β does
         (False, kept to show what that overstates).
 
+    Notes
+    -----
     Results are cached per argument set (structures are immutable).
     """
     if target not in TARGETS:

@@ -376,7 +376,7 @@ class UserMotion(Motion):
     Increments use composite Gauss–Legendre quadrature of ``rate``. The
     functions must accept arrays of times and return ``(..., 4)`` and
     ``(..., 3)``; they are the user's responsibility to keep consistent
-    (:func:`strapdown.analysis.kinematic_residual` checks them).
+    (``q̇ = ½ q ⊗ [0, ω_b]``; nothing checks it).
 
     Parameters
     ----------
