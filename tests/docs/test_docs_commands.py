@@ -8,7 +8,8 @@ working directory carries over from command to command (``cd work`` stays in eff
 trailing comment marks it, and the skip says why:
 
 - ``# long: …`` — a long run (benchmarks, the slower reproductions, each also covered by its
-  own test); set ``STRAPDOWN_DOCS_LONG=1`` to run them too;
+  own test); set ``STRAPDOWN_DOCS_LONG=1`` to run them too (then a quoted ``about N s`` or
+  ``about N min`` must be within a factor of 3 of the measured run time);
 - ``# needs STRAPDOWN_BROAD`` — the BROAD trials: ``$STRAPDOWN_BROAD``, else
   ``shared/data/broad`` beside the checkout (as for the BROAD tests);
 - ``# needs a Dask scheduler`` — a running scheduler at the address the command names.
@@ -212,3 +213,37 @@ def test_readme_lists_every_exit_status():
 
     table = re.findall(r"^\| (\d+) \| (.+) \|$", _readme_cli(), flags=re.M)
     assert [int(code) for code, _ in table] == list(EXIT_STATUS)
+
+
+#: How far a quoted duration may be from the measured one (either way): the quotes were
+#: measured on the reference machine when idle, a loaded test run is slower.
+DURATION_FACTOR = 3.0
+_ABOUT = re.compile(r"about (\d+(?:\.\d+)?) (s|min)\b")
+TIMED = [c for c in ALL if c.needs == "long" and _ABOUT.search(c.comment)]
+
+
+def quoted_seconds(comment: str) -> float:
+    m = _ABOUT.search(comment)
+    assert m is not None
+    return float(m.group(1)) * (60.0 if m.group(2) == "min" else 1.0)
+
+
+@pytest.mark.parametrize("cmd", TIMED, ids=[f"{c.doc}-{c.index:02d}-{c.line[:50]}"
+                                            for c in TIMED])
+def test_quoted_duration_is_measured(sessions, cmd):
+    """A `# long: about N s` comment is within DURATION_FACTOR of the command's run time."""
+    reason = _skip_reason(cmd)
+    if reason:
+        pytest.skip(reason)
+    session = sessions[cmd.doc]
+    session.run_through(DOCS[cmd.doc], cmd.index)
+    res = session.results[cmd.index]
+    assert res is not None and res.returncode == 0
+    quoted = quoted_seconds(cmd.comment)
+    assert quoted / DURATION_FACTOR <= res.seconds <= quoted * DURATION_FACTOR, (
+        f"{cmd.doc}: `{cmd.line}` says {cmd.comment!r} but took {res.seconds:.0f} s")
+
+
+def test_durations_are_parsed():
+    assert len(TIMED) >= 5
+    assert quoted_seconds("long: about 3.5 min") == 210.0
