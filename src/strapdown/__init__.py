@@ -108,6 +108,8 @@ _EXPORTS = {
     # input
     "read_imu": "strapdown.io",
     "InputError": "strapdown._core.errors",
+    # the compiled kernels built ahead of their first use
+    "warmup": "strapdown.apps.warmup",
 }
 #: Subpackages reachable as attributes (``strapdown.rotation``, ``strapdown.motions`` …).
 _MODULES = {

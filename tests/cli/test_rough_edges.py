@@ -238,3 +238,40 @@ def test_broad_path_messages_name_strapdown_broad(tmp_path, monkeypatch, capsys)
     monkeypatch.setenv("STRAPDOWN_BROAD", str(empty))
     code, err = _exit(capsys, "benchmark-ahrs", str(empty), "--out", str(tmp_path / "r"))
     assert "no BROAD trials (*.mat); " in err and repr(str(empty)) in err
+
+
+API_DRIVER = """
+import math
+from strapdown import AlgorithmSpec, ClassicalConing
+from strapdown.truth import sensors
+
+m = ClassicalConing(half_angle=math.radians(1.0), cone_rate=2 * math.pi)
+rec = sensors.increments(m, m.period / 60, 120)
+AlgorithmSpec.parse("rotvec:N=2").run(rec)
+AlgorithmSpec.parse("rotvec:N=2:structure=realtime").run(rec)
+"""
+
+
+def test_compile_notice_is_said_where_a_compile_happens_python_too(tmp_path):
+    """The command line's line no longer promises "once" (each command compiles the kernels
+    it needs on their first use); a Python call on a cold cache logs a notice naming what
+    compiles and strapdown.warmup(), a warm one says nothing."""
+    import os
+    import sys
+
+    import strapdown
+    from strapdown._core.compile_notice import API_MESSAGE, MESSAGE
+
+    assert "once" not in MESSAGE and "first use" in MESSAGE
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "cache")}
+    runs = [subprocess.run([sys.executable, "-c", API_DRIVER], env=env, capture_output=True,
+                           text=True, timeout=600) for _ in range(2)]
+    assert all(r.returncode == 0 for r in runs), runs[0].stderr
+    line = API_MESSAGE.format(what="the attitude algorithms")
+    assert runs[0].stderr == line + "\n"  # two kernels compiled, one line
+    assert "strapdown.warmup()" in line
+    assert runs[1].stderr == ""  # loaded from numba's cache: silent
+    took = strapdown.warmup(["navigation"])
+    assert set(took) == {"navigation"} and took["navigation"] >= 0
+    with pytest.raises(ValueError, match="unknown warm-up part"):
+        strapdown.warmup(["everything"])

@@ -11,9 +11,13 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from strapdown._core.compile_notice import python_notice
 from strapdown._core.series import SMALL_ANGLE
 
 _SMALL = SMALL_ANGLE
+# every kernel module imports this one: a Python call that compiles kernels says so (logged;
+# the commands print their own line)
+python_notice()
 
 
 @njit(cache=True, inline="always")
