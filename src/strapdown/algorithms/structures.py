@@ -149,7 +149,8 @@ def conventional(
     increments : array_like of shape (n, 3), GyroRecord or ImuLog
         Angular increments (rad) over consecutive intervals of length ``h``; or an increment
         record (:func:`strapdown.truth.sensors.increments`, :func:`strapdown.io.read_imu`),
-        which gives ``h`` and ``t0`` itself, as :meth:`AlgorithmSpec.run` takes it.
+        which gives ``h`` and ``t0`` itself, as
+        :meth:`~strapdown.algorithms.spec.AlgorithmSpec.run` takes it.
     coefficients : CoefficientSet
         Coning correction for N subsamples.
     h : float
@@ -433,9 +434,9 @@ def _record_inputs(increments: ArrayLike | GyroRecord | ImuLog, h: float | None,
                    t0: float | None, name: str) -> tuple[ArrayLike, float, float]:
     """``(increments, h, t0)`` of a structure call: an array with ``h`` (``t0`` default 0),
     or a record with ``data``, ``kind``, ``h`` and ``t`` (a GyroRecord, an ImuLog) whose
-    own interval and start edge are used, as :meth:`AlgorithmSpec.run` does (``t`` one
-    entry longer than ``data``: the interval edges; as long: the interval ends). An ``h``
-    or ``t0`` given with a record must agree with it."""
+    own interval and start edge are used, as ``AlgorithmSpec.run`` does (``t`` one entry
+    longer than ``data``: the interval edges; as long: the interval ends). An ``h`` or
+    ``t0`` given with a record must agree with it."""
     data, kind = getattr(increments, "data", None), getattr(increments, "kind", None)
     if data is None or kind is None:
         if h is None:
