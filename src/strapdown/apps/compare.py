@@ -288,7 +288,8 @@ def compare_log(imu: str | os.PathLike[str], specs: Iterable[str], out: str | os
                 progress: Callable[[str], None] | None = None, on_gap: str = "report",
                 gap_tolerance: float = 1.5, resample: bool = False,
                 accept_unit_warning: bool = False,
-                delimiter: str | None = None, timing: str = "auto",
+                delimiter: str | None = None, note: Callable[[str], None] | None = None,
+                timing: str = "auto",
                 jitter_tolerance: float | None = None, held: str = "auto",
                 duplicates: str = "error") -> list[AlgorithmRun]:
     """Run every spec on one gyro log and compare them (see the module docstring).
@@ -297,7 +298,8 @@ def compare_log(imu: str | os.PathLike[str], specs: Iterable[str], out: str | os
     rate stamps on their nominal period or ``resample``-d; ``on_gap="split"`` runs every
     spec over each gap-free segment from the previous one's last attitude; magnitudes that
     suggest another unit are an error unless ``accept_unit_warning``; ``delimiter``: the
-    CSVs', default detected; ``timing``, ``jitter_tolerance``, ``held``, ``duplicates``: the
+    CSVs', default detected; ``note``: where the log's time base is said (default
+    ``progress``); ``timing``, ``jitter_tolerance``, ``held``, ``duplicates``: the
     time base, :func:`strapdown.io.read_imu`'s). Anything wrong with the inputs is an
     :class:`~strapdown.InputError`.
     """
@@ -327,8 +329,9 @@ def compare_log(imu: str | os.PathLike[str], specs: Iterable[str], out: str | os
     title = f"{Path(imu).name}: {log.t.size} {kind} samples at {1 / h:g} Hz"
 
     def time_base() -> None:  # said once every algorithm has run, before anything is written
-        if base is not None and progress is not None:
-            progress(f"{imu}: {log.t.size} rate samples, {base.describe()}")
+        say = note or progress  # the log's time base is a finding, said even without progress
+        if base is not None and say is not None:
+            say(f"{imu}: {log.t.size} rate samples, {base.describe()}")
 
     if truth is None:
         sols = [_run_on_log(segments, f, None) for f in fields]

@@ -88,6 +88,7 @@ def run(args: argparse.Namespace) -> int:
         runs = compare.compare_log(
             args.imu, args.algorithms, args.out, kind=kind, units=args.units,
             columns=cols, sample_rate_hz=args.sample_rate_hz, truth=args.truth, progress=lines,
+            note=say,
             on_gap=args.on_gap, gap_tolerance=args.gap_tolerance,
             accept_unit_warning=args.accept_unit_warning, delimiter=args.delimiter,
             **timing_options(args))
