@@ -73,7 +73,9 @@ def _driver(script: Path) -> str:
 
 
 def _run(argv: list[str], cwd: Path) -> tuple[subprocess.CompletedProcess, float]:
-    env = dict(os.environ, MPLBACKEND="Agg", PYTHONHASHSEED="0")
+    # this checkout's package, whichever one is installed
+    path = os.pathsep.join(filter(None, [str(REPO / "src"), os.environ.get("PYTHONPATH")]))
+    env = dict(os.environ, MPLBACKEND="Agg", PYTHONHASHSEED="0", PYTHONPATH=path)
     t0 = time.perf_counter()
     proc = subprocess.run(argv, cwd=cwd, env=env, capture_output=True, text=True,
                           timeout=TIMEOUT)
