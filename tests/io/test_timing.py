@@ -170,3 +170,14 @@ def test_integer_stamps_are_made_relative_exactly(first, decimals, step):
     raw = (first + np.arange(50, dtype=np.int64) * step).astype(np.float64)
     base = relative_times(raw / 10.0**decimals, 1.0)
     assert np.allclose(base.t * 10.0**decimals, np.arange(50) * step, rtol=1e-12, atol=0)
+
+
+def test_a_block_of_identical_rows_at_the_end_is_kept():
+    """A log whose sensor stopped and whose last value was repeated for its last rows (as in
+    a re-packaged recording): each repeat has a tick of its own, so none is a held sample
+    (dropping them would silently cut the log)."""
+    rng = np.random.default_rng(8)
+    v = rng.normal(size=(N, 6))
+    v[-200:] = v[-201]
+    rc = clean_rows("tail", np.arange(N) * 0.008, v)
+    assert rc.held_candidates == 200 and rc.held == 0 and rc.keep.size == N

@@ -14,9 +14,10 @@ Rows (:func:`clean_rows`)
       policy ``duplicates="first"`` or ``"last"`` keeps one of them;
     * **held samples** — consecutive rows whose sensor values are all identical — are
       collapsed to one sample at their first stamp. With ``held="auto"`` they are collapsed
-      only when the collapse is confirmed by the clock: the collapsed stamps lie on a
-      sensor clock on which the removed rows do *not* reappear as missing samples (a sensor
-      at rest whose quantised output repeats does not pass: its repeats are real samples).
+      only when the collapse is confirmed by the clock: on the sensor clock fitted to the
+      other rows, most repeats fall on a tick a sample already holds (a sensor at rest whose
+      quantised output repeats does not pass, nor does a block of identical rows at the
+      start or the end of a log: each of those rows has a tick of its own).
 
 Clock (:func:`fit_clock`)
     Each sample ``i`` is assigned a tick ``k_i`` of a clock ``T(k) = c + p·k (+ drift)``:
@@ -302,19 +303,25 @@ def clean_rows(path: object, t: NDArray[np.float64], values: NDArray[np.float64]
 
 def _held_confirmed(t: NDArray[np.float64], drop: NDArray[np.bool_],
                     held_mask: NDArray[np.bool_], tol: float) -> bool:
-    """Whether collapsing the repeats gives a sensor clock on which they do not reappear as
-    missing samples: held samples, not a quiet sensor's real repeats."""
+    """Whether the repeats are held samples: on the sensor clock fitted to the other rows,
+    most repeats fall on a tick that a sample already holds (a logger faster than its
+    sensor stamps the same sample again between two of its ticks). A quiet sensor's real
+    repeats, or a block of identical rows at the start or the end of the log, each fall on
+    a tick of their own: they are samples."""
     if held_mask.sum() == held_mask.size - 1:  # every row the same: a constant signal
         return False
-    kept = t[~(drop | held_mask)]
+    keep = ~(drop | held_mask)
+    kept = t[keep]
     if kept.size < 8:
         return False
     try:
         clock = _fit(kept, None, tol, drift=False)
     except ValueError:
         return False
-    missing = int(clock.ticks[-1] - clock.ticks[0] + 1 - kept.size)
-    return missing < 0.5 * int(held_mask.sum())
+    with np.errstate(all="ignore"):
+        k = np.rint((t[held_mask] - clock.offset) / clock.period)
+    free = ~np.isin(k, clock.ticks.astype(np.float64))
+    return int(free.sum()) < 0.5 * int(held_mask.sum())
 
 
 @dataclass(frozen=True)
