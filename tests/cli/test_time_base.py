@@ -109,3 +109,21 @@ def test_nav_gap_options_and_sidecar(tmp_path, capsys):
     assert meta["bridged_samples"] == 20
     assert meta["timing"]["clock"]["missing_samples"] == 20
     assert meta["timing"]["clock"]["rate_hz"] == pytest.approx(100.0)
+
+
+def test_empty_cells_in_columns_not_read_do_not_refuse_the_log(tmp_path):
+    """A lab file whose reference columns are empty where the optical system lost the body:
+    only the columns named are read."""
+    t = np.arange(2000) * 1e-3
+    w = CONE.rate(t)
+    rows = [f"{a!r};{'' if k % 7 == 0 else '0.5'};{b!r};{c!r};{d!r}"
+            for k, (a, (b, c, d)) in enumerate(zip(t, w, strict=True))]
+    path = tmp_path / "lab.csv"
+    path.write_text("Time;Vicon;IMU Gyroscope;;\ns;W;rad/s;rad/s;rad/s\n" + "\n".join(rows) + "\n")
+    assert main(["run", "--imu", str(path), "--columns", "0,2,3,4", "--angles", "none",
+                 "--out", str(tmp_path / "a.csv")]) == 0
+    plain = _rate_csv(tmp_path / "plain.csv", t, w)
+    assert main(["run", "--imu", plain, "--angles", "none", "--out",
+                 str(tmp_path / "b.csv")]) == 0
+    assert np.array_equal(np.loadtxt(tmp_path / "a.csv", delimiter=",", skiprows=1),
+                          np.loadtxt(tmp_path / "b.csv", delimiter=",", skiprows=1))

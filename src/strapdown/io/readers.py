@@ -463,17 +463,27 @@ def csv_columns(path: str | os.PathLike[str], columns: Sequence[str],
         for sel, i in zip(wanted, idx, strict=True):
             if header[i] in units:
                 units[str(sel)] = units[header[i]]
-        _csv_budget(path, len(header))
-        raw = _csv_values(path, f, d, len(header))
-    return raw[:, idx], units, have_optional
+        used = sorted(set(idx))
+        _csv_budget(path, len(used))
+        if len(used) == len(header):
+            raw = _csv_values(path, f, d, len(header))
+            return raw[:, idx], units, have_optional
+        # other columns (a lab file's reference, with empty cells where the optical system
+        # lost the body) are not read, so they cannot refuse the log
+        raw = _csv_values(path, f, d, len(header), usecols=used)
+        where = {c: j for j, c in enumerate(used)}
+    return raw[:, [where[i] for i in idx]], units, have_optional
 
 
-def _csv_values(path: Path, f, delimiter: str, ncols: int) -> NDArray[np.float64]:
-    """The data rows after the header, as numbers (every row with the header's fields)."""
+def _csv_values(path: Path, f, delimiter: str, ncols: int,
+                usecols: Sequence[int] | None = None) -> NDArray[np.float64]:
+    """The data rows after the header, as numbers (every row with the header's fields; with
+    ``usecols``, those columns of every row)."""
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", UserWarning)  # "input contained no data"
-            raw = np.loadtxt(f, delimiter=delimiter, ndmin=2, dtype=np.float64)
+            raw = np.loadtxt(f, delimiter=delimiter, ndmin=2, dtype=np.float64,
+                             usecols=usecols)
     except UnicodeDecodeError as exc:
         raise InputError(f"{path}: not UTF-8 text ({_bad_bytes(exc)}); expected numbers"
                          ) from None
@@ -483,7 +493,7 @@ def _csv_values(path: Path, f, delimiter: str, ncols: int) -> NDArray[np.float64
                          ) from None
     if raw.size == 0:
         raise InputError(f"{path}: no data rows")
-    if raw.shape[1] != ncols:
+    if usecols is None and raw.shape[1] != ncols:
         raise InputError(f"{path}: rows have {raw.shape[1]} fields, the header {ncols}")
     return raw
 
