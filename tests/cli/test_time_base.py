@@ -117,7 +117,7 @@ def test_empty_cells_in_columns_not_read_do_not_refuse_the_log(tmp_path):
     t = np.arange(2000) * 1e-3
     w = CONE.rate(t)
     rows = [f"{a!r};{'' if k % 7 == 0 else '0.5'};{b!r};{c!r};{d!r}"
-            for k, (a, (b, c, d)) in enumerate(zip(t, w, strict=True))]
+            for k, (a, (b, c, d)) in enumerate(zip(t.tolist(), w.tolist(), strict=True))]
     path = tmp_path / "lab.csv"
     path.write_text("Time;Vicon;IMU Gyroscope;;\ns;W;rad/s;rad/s;rad/s\n" + "\n".join(rows) + "\n")
     assert main(["run", "--imu", str(path), "--columns", "0,2,3,4", "--angles", "none",
