@@ -43,7 +43,14 @@ from strapdown._core.validation import as_quaternions, as_vectors, finite_array
 from strapdown.algorithms import _nav_kernels
 from strapdown.algorithms.velocity import NavStructure, body_increments
 
-__all__ = ["NavSolution", "NavStream", "navigate"]
+__all__ = ["POLE_LIMIT_DEG", "NavSolution", "NavStream", "navigate"]
+
+#: Largest latitude magnitude (deg) navigated: the mechanisation runs in the local-level,
+#: north-pointing NED frame, whose transport rate (``v_E tan φ / R``) and longitude rate
+#: (``v_E / (R cos φ)``) are singular at the poles. Beyond 89.9° (about 11 km from a pole)
+#: a flight is refused, at the start or at the first update that reaches it, naming the
+#: time; crossing a pole needs a wander-azimuth mechanisation (not implemented).
+POLE_LIMIT_DEG = 89.9
 
 
 @dataclass(frozen=True)
@@ -69,6 +76,11 @@ def _initial(lat, lon, height, v0, q0):
     lat = float(finite_array(lat, "initial latitude"))
     if not abs(lat) < math.pi / 2:
         raise ValueError(f"initial latitude must lie within ±90°, got {math.degrees(lat)}°")
+    if abs(lat) > math.radians(POLE_LIMIT_DEG):
+        raise ValueError(f"initial latitude {math.degrees(lat):.9g}° lies within "
+                         f"{90 - POLE_LIMIT_DEG:g}° of a pole, where the north-pointing NED "
+                         f"mechanisation is singular; |latitude| must not exceed "
+                         f"{POLE_LIMIT_DEG:g}°")
     lon = float(finite_array(lon, "initial longitude"))
     height = float(finite_array(height, "initial height"))
     v = np.zeros(3) if v0 is None else as_vectors(v0, "initial velocity")
@@ -111,8 +123,21 @@ def navigate(gyro: ArrayLike, accel: ArrayLike, n: int, *, h: float, lat: float,
     _nav_kernels.earth_nav_kernel(b.phi, b.dv, b.update_period, lat, lon, height, v0, q0,
                                   pos, v, q)
     t = float(finite_array(t0, "t0")) + np.arange(m + 1) * b.update_period
+    _check_pole(t, pos[:, 0])
     return NavSolution(t, pos[:, 0], pos[:, 1], pos[:, 2], v, q, structure, b.n,
                        b.update_period)
+
+
+def _check_pole(t: NDArray[np.float64], lat: NDArray[np.float64]) -> None:
+    """Raise at the first update whose latitude passes :data:`POLE_LIMIT_DEG` (or is not
+    finite: past the pole the solution is garbage), naming its time."""
+    bad = ~(np.abs(lat) <= math.radians(POLE_LIMIT_DEG))
+    if np.any(bad):
+        i = int(np.argmax(bad))
+        raise ValueError(f"the flight reaches latitude {math.degrees(lat[i]):.9g}° at t = "
+                         f"{t[i]:.6g} s, within {90 - POLE_LIMIT_DEG:g}° of a pole, where the "
+                         "north-pointing NED mechanisation is singular (|latitude| at most "
+                         f"{POLE_LIMIT_DEG:g}°); nothing navigated past it")
 
 
 _Z3 = np.zeros((0, 3))
@@ -193,6 +218,7 @@ class NavStream:
                 self.update_period, self._hist, self._nh, pos, v, q)
             self._pos, self._v, self._q = pos[-1].copy(), v[-1].copy(), q[-1].copy()
         t = self._t0 + (self._updates + 1 + np.arange(m)) * self.update_period
+        _check_pole(t, pos[1:, 0])
         self._updates += m
         return NavSolution(t, pos[1:, 0], pos[1:, 1], pos[1:, 2], v[1:], q[1:],
                            self.structure, self.n, self.update_period)
