@@ -68,7 +68,9 @@ def _arguments(p: argparse.ArgumentParser) -> None:
                     "longer than 1 s (reported in the summary and OUT.meta.json)")
     timing_args(tb)
     s = p.add_argument_group("initial state")
-    s.add_argument("--init-lat", type=float, required=True, help="latitude (deg, within ±90)")
+    s.add_argument("--init-lat", type=float, required=True,
+                   help="latitude (deg, within ±89.9: the north-pointing NED mechanisation is "
+                   "singular at the poles; a flight reaching 89.9° is refused)")
     s.add_argument("--init-lon", type=float, required=True,
                    help="longitude (deg, within ±360: -180..180 or 0..360)")
     s.add_argument("--init-height", type=float, required=True,
