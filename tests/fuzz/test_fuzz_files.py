@@ -14,7 +14,7 @@ import warnings
 import pytest
 from hypothesis import HealthCheck, given, settings
 
-from fuzz import strategies as fs
+from fuzz import file_strategies as fs
 from fuzz.targets import API
 from strapdown import InputError
 
