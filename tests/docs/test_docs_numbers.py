@@ -16,9 +16,10 @@ The marker names the source, then where the value is:
 ``json KEY[.KEY…]``
     the source's standard output is JSON; a dotted path (integers index lists);
 ``csv FILE ROW COLUMN [K]``
-    a CSV file the command wrote (relative to its working directory): the first row whose
-    first cell starts with ROW, the column whose header starts with COLUMN, the K-th number
-    in that cell (default the first: cells such as ``0.00126 mm`` or ``9.71, 11.97, 7.55``);
+    a CSV file the command wrote (relative to its working directory): the row whose first
+    cell is ROW, else the first whose first cell starts with ROW; the column whose header
+    starts with COLUMN; the K-th number in that cell (default the first: cells such as
+    ``0.00126 mm`` or ``9.71, 11.97, 7.55``);
 ``re PATTERN [FILE]``
     the first group of a regular expression searched in the standard output (or FILE).
 
@@ -179,7 +180,8 @@ def extract(out: Output, where: tuple[str, ...]) -> float:
             table = list(csv.reader(fh))
         header = table[0]
         col = next(i for i, h in enumerate(header) if h.startswith(column))
-        cells = [r for r in table[1:] if r and r[0].startswith(row)]
+        cells = ([r for r in table[1:] if r and r[0] == row]
+                 or [r for r in table[1:] if r and r[0].startswith(row)])
         assert cells, f"no row starting with {row!r} in {file}: {[r[0] for r in table[1:]]}"
         numbers = _FLOAT.findall(cells[0][col].replace("−", "-"))
         return float(numbers[k - 1])
