@@ -131,6 +131,7 @@ def agrees(quoted: str, printed: float) -> bool:
 class Output:
     cwd: Path
     stdout: str
+    error: str | None = None  # the command failed: why (kept, so that it runs only once)
 
 
 def _shims(bin_dir: Path) -> None:
@@ -152,10 +153,14 @@ def run_source(tmp_path_factory):
     def run_command(command: str, name: str) -> Output:
         cwd = tmp_path_factory.mktemp(f"numbers-{name}")
         (cwd / "examples").symlink_to(REPO / "examples", target_is_directory=True)
-        proc = subprocess.run(["bash", "-c", command], cwd=cwd, env=env,
-                              capture_output=True, text=True, timeout=1800)
-        assert proc.returncode == 0, (f"source {name}: `{command}` exited "
-                                      f"{proc.returncode}:\n{proc.stderr[-3000:]}")
+        try:
+            proc = subprocess.run(["bash", "-c", command], cwd=cwd, env=env,
+                                  capture_output=True, text=True, timeout=1800)
+        except subprocess.TimeoutExpired:
+            return Output(cwd, "", f"source {name}: `{command}` ran over 1800 s")
+        if proc.returncode:
+            return Output(cwd, proc.stdout, f"source {name}: `{command}` exited "
+                                            f"{proc.returncode}:\n{proc.stderr[-3000:]}")
         return Output(cwd, proc.stdout)
 
     def run(key: tuple[str, str]) -> Output:
@@ -209,7 +214,9 @@ def test_quoted_number_is_what_the_command_prints(run_source, quote):
     if src.long and not LONG:
         pytest.skip(f"source {src.name} is long: `{src.command}` (STRAPDOWN_DOCS_LONG=1 "
                     "runs it)")
-    printed = extract(run_source(_key(quote)), quote.where)
+    out = run_source(_key(quote))
+    assert out.error is None, out.error
+    printed = extract(out, quote.where)
     assert agrees(quote.quoted, printed), (
         f"{quote.doc}:{quote.line} quotes {quote.quoted}; `{src.command}` prints {printed!r}"
         f" (rounded to the quoted digits: {printed:.{significant_digits(quote.quoted) - 1}e})")
