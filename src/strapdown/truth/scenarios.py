@@ -567,9 +567,15 @@ def loiter(*, speed: float = 20.0, bank_deg: float = 20.0, straight_s: float = 8
             return np.asarray(getattr(flight.sample(flat), attr)).reshape((*t.shape, k))
         return fn
 
+    start = sampled("position", 3)
+    v0 = flight.sample(np.array([0.0])).velocity[0]
+
+    def position(t):  # before 0: the straight leg's start, extended back
+        t = np.asarray(t, dtype=np.float64)
+        return start(t) + np.minimum(t, 0.0)[..., None] * v0
+
     motion = UserMotion(sampled("q", 4), sampled("omega", 3))
-    body = Body(motion, sampled("acceleration", 3), sampled("velocity", 3),
-                sampled("position", 3))
+    body = Body(motion, sampled("acceleration", 3), sampled("velocity", 3), position)
     radius = speed**2 / (G * math.tan(math.radians(bank_deg)))
     return Scenario(name, "loiter", body, float(duration_s), float(straight_s),
                     Sensors(rate_hz, mag_unit=mag_unit),
