@@ -1,0 +1,54 @@
+"""``strapdown benchmark-ahrs --suite generalisation``: our AHRS and VQF, causal and offline,
+on short versions of every simulated scenario give finite errors and a table (no thresholds
+on the ratios here: what they are is docs/reproductions.md's business)."""
+
+from __future__ import annotations
+
+import csv
+import math
+
+import pytest
+
+from strapdown.apps.ahrs_generalisation import FILTERS, SHORT_S, trial
+from strapdown.cli import main
+from strapdown.truth.scenarios import SCENARIO_KINDS, record, suite
+
+
+def test_short_suite_runs_every_filter_on_every_scenario(tmp_path, capsys):
+    pytest.importorskip("vqf")
+    main(["benchmark-ahrs", "--suite", "generalisation", "--short", "--out", str(tmp_path),
+          "--no-progress"])
+    out = capsys.readouterr().out
+    names = [s.name for s in suite(0)]
+    with open(tmp_path / "errors.csv", encoding="utf-8") as f:
+        rows = list(csv.DictReader(f))
+    assert {(r["scenario"], r["filter"]) for r in rows} == {(n, f) for n in names
+                                                            for f in FILTERS}
+    for r in rows:
+        for key in ("total (°)", "heading (°)", "inclination (°)"):
+            v = float(r[key])
+            assert math.isfinite(v) and 0 <= v < 180, (r, key)
+    table = [line for line in out.splitlines() if line.startswith("| ")]
+    assert len(table) == 1 + len(names) + 1  # header, scenarios, mean
+    for line, name in zip(table[1:], names, strict=False):
+        cells = [c.strip() for c in line.strip("| ").split("|")]
+        assert cells[0] == name
+        ratios = [float(c) for c in cells[-2:]]
+        assert all(math.isfinite(x) and x > 0 for x in ratios)
+    assert (tmp_path / "report.md").read_text(encoding="utf-8").count("pendulum-") >= 3
+
+
+def test_trial_scores_from_five_seconds_with_the_truth_as_reference():
+    sc = suite(0)[0]
+    rec = record(sc, 0, duration_s=SHORT_S)
+    tr = trial(rec)
+    assert tr.movement.sum() == (rec.t >= 5.0).sum() and not tr.movement[0]
+    assert tr.q_ref is rec.q_n_b and tr.h == pytest.approx(1 / sc.sensors.rate_hz)
+    assert {s.kind for s in suite(0)} == set(SCENARIO_KINDS)
+
+
+def test_generalisation_takes_no_directory(capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["benchmark-ahrs", "somewhere", "--suite", "generalisation", "--no-progress"])
+    assert exc.value.code == 2
+    assert "takes no DIR" in capsys.readouterr().err
