@@ -19,7 +19,7 @@ Nothing here is written into the checkout: every page below is added to the buil
     the reports of paper reproductions (``strapdown reproduce NAME --out DIR``), run at build
     time with their figures and tables: the quick one, :data:`BUILD_REPRODUCTIONS`, by
     default; ``STRAPDOWN_DOCS_REPRODUCTIONS=all`` (or a comma-separated list of names) for a
-    published site, which then takes minutes (``reproduce sculling`` alone 3.5 min).
+    published site, which then takes minutes (``reproduce sculling`` alone 1.5 min).
 
 The scripts and reproductions run as subprocesses started when the configuration is loaded,
 two at a time, while MkDocs reads the pages.
@@ -32,6 +32,7 @@ import html
 import logging
 import os
 import pkgutil
+import re
 import shutil
 import subprocess
 import sys
@@ -48,7 +49,7 @@ log = logging.getLogger("mkdocs.plugins.strapdown_docs")
 REPO = Path(__file__).resolve().parents[1]
 EXAMPLES = REPO / "examples"
 #: Reproductions run at build time by default: the one under 10 s, also with a cold numba
-#: cache (li2017 takes 15-30 s, wang-sliding 35 s cold: it compiles the EKF, sculling 3.5
+#: cache (li2017 takes 15-30 s, wang-sliding 35 s cold: it compiles the EKF, sculling 1.5
 #: min), so that `make docs` and the test that builds the site stay under a minute.
 BUILD_REPRODUCTIONS = ("plaksiy2024",)
 #: The longest first, so that two workers finish together.
@@ -238,6 +239,8 @@ def _first_paragraph(script: Path) -> tuple[str, str]:
     import ast
 
     doc = ast.get_docstring(ast.parse(script.read_text("utf-8"))) or script.stem
+    # reStructuredText to Markdown, as far as a script's docstring needs: roles and literals
+    doc = re.sub(r":\w+:`~?([^`]+)`", r"``\1``", doc).replace("``", "`")
     title, _, rest = doc.partition("\n\n")
     return " ".join(title.split()), rest
 
@@ -255,7 +258,7 @@ def _gallery_pages() -> tuple[dict[str, str], dict[str, bytes]]:
         body = [f"# {title}\n", f"`examples/{script.name}` — ran in {res['seconds']:.1f} s at "
                 "build time.\n"]
         if rest:
-            body.append("```text\n" + rest.strip() + "\n```\n")
+            body.append(rest.strip() + "\n")
         body.append("## Source\n\n```python\n" + script.read_text("utf-8").rstrip() + "\n```\n")
         body.append("## Output\n\n```text\n" + (res["stdout"].rstrip() or "(nothing)") +
                     "\n```\n")
