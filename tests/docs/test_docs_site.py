@@ -112,7 +112,8 @@ def test_a_broken_cross_reference_fails_the_build(tmp_path):
     config.update(docs_dir=str(docs), site_dir=str(tmp_path / "site"))
     config.pop("hooks", None)
     config.pop("nav", None)
-    handler = config["plugins"][2]["mkdocstrings"]["handlers"]["python"]
+    plugin = next(p for p in config["plugins"] if isinstance(p, dict) and "mkdocstrings" in p)
+    handler = plugin["mkdocstrings"]["handlers"]["python"]
     handler["paths"] = [str(REPO / "src")]
     handler["options"]["extensions"] = ["griffe_sphinx"]
     path = tmp_path / "mkdocs.yml"
