@@ -122,3 +122,32 @@ def test_a_broken_cross_reference_fails_the_build(tmp_path):
     assert proc.returncode != 0
     assert "no-such-heading" in proc.stderr
     assert re.search(r"strapdown\.algorithms\.spec\.no_such_name", proc.stderr), proc.stderr
+
+
+def test_docstring_roles_become_references(caplog):
+    """tools/griffe_sphinx_roles.py: a role naming an object of the package becomes a
+    reference to where the site renders it; one naming nothing there is a warning (which
+    fails the strict build); one outside the package is code."""
+    import importlib.util
+    import logging
+
+    import griffe
+
+    spec = importlib.util.spec_from_file_location("griffe_sphinx_roles",
+                                                  REPO / "tools" / "griffe_sphinx_roles.py")
+    roles = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(roles)
+    pkg = griffe.load("strapdown", search_paths=[str(REPO / "src")])
+    where = pkg["algorithms.spec"]
+    convert = roles._convert
+    assert convert(pkg, where, ":class:`AlgorithmSpec`") == (
+        "[`AlgorithmSpec`][strapdown.algorithms.spec.AlgorithmSpec]")
+    assert convert(pkg, where, ":mod:`.rotvec`") == "[`rotvec`][strapdown.algorithms.rotvec]"
+    assert convert(pkg, where, ":func:`~strapdown.read_imu`") == (
+        "[`read_imu()`][strapdown.io.readers.read_imu]")
+    assert convert(pkg, where, ":class:`numpy.random.Generator`") == (
+        "`numpy.random.Generator`")
+    with caplog.at_level(logging.WARNING):
+        assert convert(pkg, where, ":func:`strapdown.no_such_name`") == (
+            "`strapdown.no_such_name()`")
+    assert "broken reference" in caplog.text
