@@ -127,3 +127,13 @@ def test_empty_cells_in_columns_not_read_do_not_refuse_the_log(tmp_path):
                  str(tmp_path / "b.csv")]) == 0
     assert np.array_equal(np.loadtxt(tmp_path / "a.csv", delimiter=",", skiprows=1),
                           np.loadtxt(tmp_path / "b.csv", delimiter=",", skiprows=1))
+
+
+def test_every_command_help_points_to_the_conventions_page(capsys):
+    from strapdown.cli import COMMANDS
+
+    names = [c.__name__.rsplit(".", 1)[-1].replace("_", "-") for c in COMMANDS]
+    for name in names:
+        with pytest.raises(SystemExit):
+            main([name, "--help"])
+        assert "docs/conventions.md" in capsys.readouterr().out, name

@@ -70,6 +70,11 @@ class Parser(argparse.ArgumentParser):
         super().__init__(*args, **kwargs)
 
 
+#: Every subcommand's help ends by pointing to the conventions page.
+CONVENTIONS_EPILOG = ("conventions (frames, units, time stamps, quaternion order w x y z, "
+                      "q_n_b): docs/conventions.md, or the reference site's Conventions page")
+
+
 class CommandParser(Parser):
     """A subcommand's parser that adds its options on first use.
 
@@ -82,6 +87,7 @@ class CommandParser(Parser):
 
     def __init__(self, *args, arguments: Callable[[Parser], None] | None = None,
                  **kwargs) -> None:
+        kwargs.setdefault("epilog", CONVENTIONS_EPILOG)
         super().__init__(*args, **kwargs)
         self._arguments = arguments
 
