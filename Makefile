@@ -25,9 +25,11 @@ demo: $(STAMP)
 	$(VENV)/bin/strapdown reproduce li2017 --out $(DEMO_OUT)
 	@echo "Report: $(DEMO_OUT)/report.md"
 
-## test: install dev extras, lint (style, import layers, types), run the whole suite
+## test: install dev extras, lint (style, import layers, types), run the whole suite on every
+## core (pytest-xdist; a module's tests that share its fixture run on one worker) and list the
+## slowest 20 tests
 test: lint
-	$(PY) -m pytest -q
+	$(PY) -m pytest -q -n auto --durations=20
 
 ## fuzz: the long fuzz campaign — the corpus and >= 10^4 generated hostile files through every
 ## reader and every command that reads a file, under a memory cap and a time limit (counts per
