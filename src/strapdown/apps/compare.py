@@ -51,9 +51,10 @@ from strapdown._core.errors import InputError, shown
 from strapdown._core.kinds import InputKind
 from strapdown.algorithms.spec import AlgorithmSpec, parse_spec
 from strapdown.analysis.evaluate import EvaluationConfig, evaluate, run_evaluation
+from strapdown.apps._figures import plot_curves
 from strapdown.io.files import write_text
 from strapdown.io.readers import GyroUnit
-from strapdown.io.report import Curve, Report, plot_error_curves
+from strapdown.io.report import Curve, Report
 
 __all__ = ["AlgorithmRun", "compare_log", "compare_motion"]
 
@@ -479,7 +480,7 @@ def _against_reference(specs, sols, tol):
 def _write(out, runs, title, what, progress, *, ylabel: str, notes=(), pairs=None) -> None:
     rep = Report.begin(out, progress)
     fig, ax = rep.plt.subplots(figsize=(8, 4.5))
-    plot_error_curves(ax, [_curve(r, pairs is not None) for r in runs], ylabel=ylabel)
+    plot_curves(ax, [_curve(r, pairs is not None) for r in runs], ylabel=ylabel)
     ax.set_title(f"{title}\n{what}", fontsize=9)
     rep.figure("error_vs_time.png", fig)
     header = list(runs[0].summary)
