@@ -72,7 +72,7 @@ def envelope(t: NDArray[np.float64], y: NDArray[np.float64], span: tuple[float, 
         trend = np.where(empty | (n_run == 0), np.nan, s_run / n_run)
     lo[empty] = np.nan
     hi[empty] = np.nan
-    centres = t0 + (np.arange(bins) + 0.5) * width
+    centres = (t0 + (np.arange(bins) + 0.5) * width).astype(np.float64)
     return Envelope(centres, lo, hi, trend, w * width)
 
 

@@ -178,6 +178,7 @@ def _table(adv, ref) -> list[str]:
                      f"{ref.upsample}, single chain N = 6), {ref.window[0]:.3g}–"
                      f"{ref.window[1]:.3g} s; reference accurate to {ref.accuracy_deg_h:.2g} "
                      f"deg/h (×{ref.upsample // 2} against ×{ref.upsample})")
+    lines += [f"prediction against measurement, {n}" for n in adv.gap_notes]
     lines.append(f"recommended   {adv.recommended.spec} ({adv.reason})")
     lines.append("(* recommended, P Pareto front: no other candidate is both cheaper and "
                  "better predicted)")
