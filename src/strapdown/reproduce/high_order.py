@@ -413,17 +413,58 @@ def _spin_section(r: Report) -> list[str]:
     return summary
 
 
+#: A value more than this many decades below the next larger one of a panel is an outlier
+#: (the exact drift at ω_s/Ω = 1 is 0: what is left is the arithmetic's precision).
+OUTLIER_GAP_DEX = 8.0
+
+
+def outlier_floor(values) -> tuple[float, float] | None:
+    """``(cut, floor)`` when the positive ``values`` split into a bulk and points more than
+    :data:`OUTLIER_GAP_DEX` decades below it: ``cut`` the middle of the gap (in decades),
+    ``floor`` a decade and a half below the bulk's smallest value, where the outliers are
+    drawn (None: no such gap)."""
+    v = np.sort(np.log10(np.asarray([x for x in values if x > 0 and np.isfinite(x)])))
+    if v.size < 2:
+        return None
+    gaps = np.diff(v)
+    k = int(np.argmax(gaps))
+    if gaps[k] <= OUTLIER_GAP_DEX:
+        return None
+    return float(10 ** ((v[k] + v[k + 1]) / 2)), float(10 ** (v[k + 1] - 1.5))
+
+
 def _spin_figure(r: Report, d: dict, labels: list[str]) -> None:
     fig, axes = r.plt.subplots(1, len(SPIN_CASES), figsize=(6 * len(SPIN_CASES), 4.2),
                                squeeze=False)
+    ratios = np.asarray(SPIN_RATIOS, float)
     for ax, (case, _, _) in zip(axes[0], SPIN_CASES, strict=True):
+        ys = {lab: np.abs(np.asarray(d[case, lab], float)) for lab in labels}
+        cut = outlier_floor(np.concatenate(list(ys.values())))
+        low: list[float] = []
         for k, lab in enumerate(labels):
-            y = np.abs(d[case, lab])
-            ax.semilogy(SPIN_RATIOS, np.where(y > 0, y, np.nan), "-" + "osD^vP"[k], ms=3,
-                        label=lab)
+            y = np.where(ys[lab] > 0, ys[lab], np.nan)
+            if cut is not None:
+                below = y < cut[0]
+                low += list(y[below])
+                y = np.where(below, cut[1], y)
+                ax.semilogy(ratios[below], y[below], "v", ms=7, mfc="none", color=f"C{k}",
+                            zorder=3)
+            ax.semilogy(ratios, y, "-" + "osD^vP"[k], ms=3, label=lab, color=f"C{k}")
+        if cut is not None:
+            ax.axhline(cut[1], color="0.5", lw=0.8, ls=":")
+            at = sorted({f"{s:g}" for lab in labels for s, v in zip(
+                SPIN_RATIOS, ys[lab], strict=True) if 0 < v < cut[0]})
+            why = (f"\n(exactly 0 there — rotation about a fixed axis; the rest is the "
+                   f"{DIGITS}-digit arithmetic)" if at == ["1"] else "")
+            span = (f"{min(low):.0e}" if f"{min(low):.0e}" == f"{max(low):.0e}"
+                    else f"{min(low):.0e}–{max(low):.0e}")
+            ax.annotate(f"▽ drawn at {cut[1]:.0e}: |drift| {span} at "
+                        f"ω_s/Ω = {', '.join(at)}{why}",
+                        (0.02, 0.03), xycoords="axes fraction", fontsize=7, color="0.3")
+            ax.set_ylim(bottom=cut[1] / 30)
         ax.set(xlabel="spin / cone rate ω_s/Ω", ylabel="|drift| (rad/s)", title=case)
         ax.grid(True, which="both", alpha=0.3)
-    axes[0, 0].legend(fontsize=7)
+    axes[0, 0].legend(fontsize=7, loc="upper left")
     fig.tight_layout()
     r.figure("spin_coning.png", fig)
     r.add("\n![spin plus coning](spin_coning.png)\n")
