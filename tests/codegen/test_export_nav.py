@@ -84,7 +84,7 @@ def test_reset_restarts_and_the_code_is_allocation_free(tmp_path, log):
                v.ctypes.data_as(dbl), q.ctypes.data_as(dbl))
     assert np.array_equal(np.concatenate([p, v, q]), first[0])
     src = e.source + e.header
-    assert "malloc" not in src and "free(" not in src and "static real_t" not in src
+    assert "malloc" not in src and "free(" not in src and f"static {e.name}_real" not in src
     calls = set(re.findall(r"\b(sqrt|sin|cos|tan|exp|log|pow|atan2|fabs)\(", e.source))
     assert calls == {"sqrt", "sin", "cos"}
     assert "sculling 2/3" in e.source  # the two-sample sculling coefficient, exact form

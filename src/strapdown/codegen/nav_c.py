@@ -20,6 +20,7 @@ Adams–Moulton rules of the position rates at the updates (see
 
 from __future__ import annotations
 
+import re
 from fractions import Fraction
 
 from strapdown.algorithms import _nav_kernels as nk
@@ -28,7 +29,7 @@ from strapdown.algorithms.coning import coefficient_set
 from strapdown.algorithms.structures import single_chain_coefficients
 from strapdown.algorithms.velocity import NAV_STRUCTURES, sculling_matrix
 
-__all__ = ["generate_nav", "nav_ops"]
+__all__ = ["fill_names", "generate_nav", "nav_ops"]
 
 
 def _lit(x) -> str:
@@ -40,8 +41,16 @@ def _frac(x) -> str:
     return f"{x.numerator}/{x.denominator}" if isinstance(x, Fraction) else repr(float(x))
 
 
-_CONSTANTS = {"SD_A": nk._A, "SD_F": nk._F, "SD_E2": nk._E2, "SD_OMEGA": nk._OMEGA,
-              "SD_GE": nk._GE, "SD_GK": nk._GK, "SD_GM": nk._GM_RATIO}
+_CONSTANTS = {"PREFIX_A": nk._A, "PREFIX_F": nk._F, "PREFIX_E2": nk._E2, "PREFIX_OMEGA": nk._OMEGA,
+              "PREFIX_GE": nk._GE, "PREFIX_GK": nk._GK, "PREFIX_GM": nk._GM_RATIO}
+
+
+def fill_names(text: str, name: str) -> str:
+    """A template with its placeholders filled in one pass: ``NAME`` by the module name (its
+    functions and types, e.g. ``NAME_real``, ``NAME_state``), ``PREFIX_`` by the upper-case
+    name and ``_`` (its macros), so every generated type and macro carries the prefix."""
+    return re.sub(r"NAME|PREFIX_", lambda m: name if m.group() == "NAME"
+                  else name.upper() + "_", text)
 
 
 def _helpers() -> str:
@@ -51,7 +60,7 @@ def _helpers() -> str:
 /* WGS-84 (NIMA TR8350.2 (2000)): semi-major axis, flattening, e^2, Earth rate, Somigliana */
 {consts}
 
-static void sd_cross(const real_t a[3], const real_t b[3], real_t out[3])
+static void sd_cross(const NAME_real a[3], const NAME_real b[3], NAME_real out[3])
 {{
     out[0] = a[1] * b[2] - a[2] * b[1];
     out[1] = a[2] * b[0] - a[0] * b[2];
@@ -59,34 +68,34 @@ static void sd_cross(const real_t a[3], const real_t b[3], real_t out[3])
 }}
 
 /* out = v + 1/2 a x v + 1/6 a x (a x v): rotation compensation to second order */
-static void sd_rotation_comp(const real_t a[3], const real_t u[3], real_t out[3])
+static void sd_rotation_comp(const NAME_real a[3], const NAME_real u[3], NAME_real out[3])
 {{
-    real_t cx = a[1] * u[2] - a[2] * u[1];
-    real_t cy = a[2] * u[0] - a[0] * u[2];
-    real_t cz = a[0] * u[1] - a[1] * u[0];
+    NAME_real cx = a[1] * u[2] - a[2] * u[1];
+    NAME_real cy = a[2] * u[0] - a[0] * u[2];
+    NAME_real cz = a[0] * u[1] - a[1] * u[0];
     out[0] = u[0] + 0.5 * cx + (a[1] * cz - a[2] * cy) / 6.0;
     out[1] = u[1] + 0.5 * cy + (a[2] * cx - a[0] * cz) / 6.0;
     out[2] = u[2] + 0.5 * cz + (a[0] * cy - a[1] * cx) / 6.0;
 }}
 
 /* out = C(q) x */
-static void sd_rotate(const real_t q[4], const real_t x[3], real_t out[3])
+static void sd_rotate(const NAME_real q[4], const NAME_real x[3], NAME_real out[3])
 {{
-    real_t tx = 2.0 * (q[2] * x[2] - q[3] * x[1]);
-    real_t ty = 2.0 * (q[3] * x[0] - q[1] * x[2]);
-    real_t tz = 2.0 * (q[1] * x[1] - q[2] * x[0]);
+    NAME_real tx = 2.0 * (q[2] * x[2] - q[3] * x[1]);
+    NAME_real ty = 2.0 * (q[3] * x[0] - q[1] * x[2]);
+    NAME_real tz = 2.0 * (q[1] * x[1] - q[2] * x[0]);
     out[0] = x[0] + q[0] * tx + (q[2] * tz - q[3] * ty);
     out[1] = x[1] + q[0] * ty + (q[3] * tx - q[1] * tz);
     out[2] = x[2] + q[0] * tz + (q[1] * ty - q[2] * tx);
 }}
 
 /* out = normalise(q(z) (x) q), exact exponential, series below |z|/2 < 1e-2 */
-static void sd_left_update(const real_t z[3], const real_t q[4], real_t out[4])
+static void sd_left_update(const NAME_real z[3], const NAME_real q[4], NAME_real out[4])
 {{
-    real_t ang = sqrt(z[0] * z[0] + z[1] * z[1] + z[2] * z[2]);
-    real_t half = 0.5 * ang, s, dw, dx, dy, dz, w, x, y, zz, inv;
+    NAME_real ang = sqrt(z[0] * z[0] + z[1] * z[1] + z[2] * z[2]);
+    NAME_real half = 0.5 * ang, s, dw, dx, dy, dz, w, x, y, zz, inv;
     if (half < 1e-2) {{
-        real_t x2 = half * half;
+        NAME_real x2 = half * half;
         s = 0.5 * (1.0 - x2 / 6.0 * (1.0 - x2 / 20.0 * (1.0 - x2 / 42.0)));
         dw = 1.0 - x2 / 2.0 * (1.0 - x2 / 12.0 * (1.0 - x2 / 30.0 * (1.0 - x2 / 56.0)));
     }} else {{
@@ -113,19 +122,19 @@ def _step() -> str:
     """One navigation update from body increments (``earth_nav_chunk_kernel``'s loop body)."""
     return """
 /* out[0..2] = w_in, out[3..5] = gamma - (w_ie + w_in) x v, out[6..8] = (dlat, dlon, dh)/dt */
-static void sd_rates(real_t lat, real_t hgt, const real_t v[3], real_t out[9])
+static void sd_rates(NAME_real lat, NAME_real hgt, const NAME_real v[3], NAME_real out[9])
 {
-    real_t sl = sin(lat), cl = cos(lat), s2, d, sq, e0, e1, g0, gam, wie0, wie2, w0, w1, w2;
+    NAME_real sl = sin(lat), cl = cos(lat), s2, d, sq, e0, e1, g0, gam, wie0, wie2, w0, w1, w2;
     s2 = sl * sl;
-    d = 1.0 - SD_E2 * s2;
+    d = 1.0 - PREFIX_E2 * s2;
     sq = sqrt(d);
-    e0 = SD_A * (1.0 - SD_E2) / (d * sq) + hgt;
-    e1 = SD_A / sq + hgt;
-    g0 = SD_GE * (1.0 + SD_GK * s2) / sq;
-    gam = g0 * (1.0 - 2.0 / SD_A * (1.0 + SD_F + SD_GM - 2.0 * SD_F * s2) * hgt
-                + 3.0 * hgt * hgt / (SD_A * SD_A));
-    wie0 = SD_OMEGA * cl;
-    wie2 = -SD_OMEGA * sl;
+    e0 = PREFIX_A * (1.0 - PREFIX_E2) / (d * sq) + hgt;
+    e1 = PREFIX_A / sq + hgt;
+    g0 = PREFIX_GE * (1.0 + PREFIX_GK * s2) / sq;
+    gam = g0 * (1.0 - 2.0 / PREFIX_A * (1.0 + PREFIX_F + PREFIX_GM - 2.0 * PREFIX_F * s2) * hgt
+                + 3.0 * hgt * hgt / (PREFIX_A * PREFIX_A));
+    wie0 = PREFIX_OMEGA * cl;
+    wie2 = -PREFIX_OMEGA * sl;
     out[0] = wie0 + v[1] / e1;
     out[1] = -v[0] / e0;
     out[2] = wie2 - v[1] * (sl / cl) / e1;
@@ -141,7 +150,7 @@ static void sd_rates(real_t lat, real_t hgt, const real_t v[3], real_t out[9])
 }
 
 /* Adams-Moulton mean over an update from its end (a) and the k - 1 updates before */
-static inline real_t sd_am(int k, real_t a, real_t b, real_t c, real_t d)
+static inline NAME_real sd_am(int k, NAME_real a, NAME_real b, NAME_real c, NAME_real d)
 {
     if (k == 2) return 0.5 * (a + b);
     if (k == 3) return (5.0 * a + 8.0 * b - c) / 12.0;
@@ -149,7 +158,7 @@ static inline real_t sd_am(int k, real_t a, real_t b, real_t c, real_t d)
 }
 
 /* the value at the update's end extrapolated from the k - 1 before */
-static inline real_t sd_extrap(int k, real_t b, real_t c, real_t d)
+static inline NAME_real sd_extrap(int k, NAME_real b, NAME_real c, NAME_real d)
 {
     if (k == 2) return b;
     if (k == 3) return 2.0 * b - c;
@@ -157,12 +166,12 @@ static inline real_t sd_extrap(int k, real_t b, real_t c, real_t d)
 }
 
 /* the navigation update from the body increments phi, dvb over one update period */
-static void sd_nav_step(NAME_state *s, const real_t phi[3], const real_t dvb[3])
+static void sd_nav_step(NAME_state *s, const NAME_real phi[3], const NAME_real dvb[3])
 {
-    const real_t T = s->period;
-    real_t (*H)[12] = s->hist;
-    real_t zeta[3], x[3], an[3], t1[3], t2[3], t3[3], t4[3], t5[3], dx[3], pred[9], end[9];
-    real_t pp[3], vn[3], pn[3], qb[4], w;
+    const NAME_real T = s->period;
+    NAME_real (*H)[12] = s->hist;
+    NAME_real zeta[3], x[3], an[3], t1[3], t2[3], t3[3], t4[3], t5[3], dx[3], pred[9], end[9];
+    NAME_real pp[3], vn[3], pn[3], qb[4], w;
     int c, k;
     if (s->nh == 0) {
         sd_rates(s->pos[0], s->pos[2], s->v, H[0]);
@@ -230,12 +239,12 @@ def _conventional(n: int) -> tuple[str, str, dict[str, int]]:
     # sums, so the order within each sum (i outer, j inner) is what is kept
     coning = _cross_terms(kc, kx, "coning", "s->th", "s->th", "phi", False)
     scul = _cross_terms(ks, sx, "sculling", "s->th", "s->dv", "dvb", True)
-    fields = f"    real_t th[{n}][3];\n    real_t dv[{n}][3];\n    int count;"
+    fields = f"    NAME_real th[{n}][3];\n    NAME_real dv[{n}][3];\n    int count;"
     body = f"""
-int NAME_update(NAME_state *s, const real_t dth[3], const real_t dv[3], real_t pos[3],
-                real_t vel[3], real_t q[4])
+int NAME_update(NAME_state *s, const NAME_real dth[3], const NAME_real dv[3], NAME_real pos[3],
+                NAME_real vel[3], NAME_real q[4])
 {{
-    real_t alpha[3] = {{0.0, 0.0, 0.0}}, ups[3] = {{0.0, 0.0, 0.0}}, phi[3], dvb[3];
+    NAME_real alpha[3] = {{0.0, 0.0, 0.0}}, ups[3] = {{0.0, 0.0, 0.0}}, phi[3], dvb[3];
     int i, j;
     for (i = 0; i < 3; ++i) {{ s->th[s->count][i] = dth[i]; s->dv[s->count][i] = dv[i]; }}
     s->count += 1;
@@ -268,25 +277,25 @@ def _single_chain(n: int) -> tuple[str, str, dict[str, int]]:
 
     coning = [list(single_chain_coefficients(m + 1)) if m else [] for m in range(n)]
     scul = [list(tables.SCULLING_SINGLE_CHAIN[m + 1]) if m else [] for m in range(n)]
-    fields = (f"    real_t th[{width}][3];\n    real_t dv[{width}][3];\n    long k;")
+    fields = (f"    NAME_real th[{width}][3];\n    NAME_real dv[{width}][3];\n    long k;")
     body = f"""
-static const real_t SC_CONING[{n}][{width}] = {{
+static const NAME_real SC_CONING[{n}][{width}] = {{
 {table(coning)}
 }};
-static const real_t SC_SCULLING[{n}][{width}] = {{
+static const NAME_real SC_SCULLING[{n}][{width}] = {{
 {table(scul)}
 }};
 
-int NAME_update(NAME_state *s, const real_t dth[3], const real_t dv[3], real_t pos[3],
-                real_t vel[3], real_t q[4])
+int NAME_update(NAME_state *s, const NAME_real dth[3], const NAME_real dv[3], NAME_real pos[3],
+                NAME_real vel[3], NAME_real q[4])
 {{
-    real_t phi[3], dvb[3];
+    NAME_real phi[3], dvb[3];
     int row = (int)(s->k < {n - 1} ? s->k : {n - 1}), m, i;
     for (i = 0; i < 3; ++i) phi[i] = dth[i];
     sd_rotation_comp(dth, dv, dvb);
     for (m = 1; m <= row; ++m) {{
-        const real_t *tp = s->th[(s->k - m) % {width}], *vp = s->dv[(s->k - m) % {width}];
-        real_t cc = SC_CONING[row][m - 1], cs = SC_SCULLING[row][m - 1];
+        const NAME_real *tp = s->th[(s->k - m) % {width}], *vp = s->dv[(s->k - m) % {width}];
+        NAME_real cc = SC_CONING[row][m - 1], cs = SC_SCULLING[row][m - 1];
         if (cc != 0.0) sd_cross_add(phi, cc, tp, dth);
         if (cs != 0.0) {{ sd_cross_add(dvb, cs, tp, dv); sd_cross_add(dvb, cs, vp, dth); }}
     }}
@@ -348,21 +357,21 @@ _API = """
 unsigned long NAME_state_size(void);
 /* Initialise: sample interval h (s), position pos0 = (latitude, longitude in rad, height in
    m above the ellipsoid), NED velocity v0 (m/s), attitude q0 = q_n_b (unit, scalar first). */
-void NAME_init(NAME_state *s, real_t h, const real_t pos0[3], const real_t v0[3],
-               const real_t q0[4]);
+void NAME_init(NAME_state *s, NAME_real h, const NAME_real pos0[3], const NAME_real v0[3],
+               const NAME_real q0[4]);
 /* Back to the state right after init. */
 void NAME_reset(NAME_state *s);
 /* Feed one gyro increment (rad) and one accelerometer increment (m/s) over h; returns 1 and
    writes position, NED velocity and q_n_b when an update completes, else 0. */
-int NAME_update(NAME_state *s, const real_t dth[3], const real_t dv[3], real_t pos[3],
-                real_t vel[3], real_t q[4]);
+int NAME_update(NAME_state *s, const NAME_real dth[3], const NAME_real dv[3], NAME_real pos[3],
+                NAME_real vel[3], NAME_real q[4]);
 """
 
 _INIT = """
 unsigned long NAME_state_size(void) { return (unsigned long)sizeof(NAME_state); }
 
-void NAME_init(NAME_state *s, real_t h, const real_t pos0[3], const real_t v0[3],
-               const real_t q0[4])
+void NAME_init(NAME_state *s, NAME_real h, const NAME_real pos0[3], const NAME_real v0[3],
+               const NAME_real q0[4])
 {
     int i;
     s->h = h;
@@ -376,7 +385,7 @@ void NAME_init(NAME_state *s, real_t h, const real_t pos0[3], const real_t v0[3]
 
 void NAME_reset(NAME_state *s)
 {
-    real_t p[3], v[3], q[4];
+    NAME_real p[3], v[3], q[4];
     int i;
     for (i = 0; i < 3; ++i) { p[i] = s->pos0[i]; v[i] = s->v0[i]; }
     for (i = 0; i < 4; ++i) q[i] = s->q0[i];
@@ -403,9 +412,9 @@ def generate_nav(structure: str, n: int, name: str, update_helpers: str) -> tupl
         fields, body, ops = _single_chain(n)
         period, counter = "h", "k"
         what = f"single chain, an update every sample with N = {n} accuracy"
-    struct = (f"typedef struct {{\n    real_t h, period;\n{fields}\n"
-              "    real_t pos[3], v[3], q[4], hist[3][12];\n    int nh;\n"
-              "    real_t pos0[3], v0[3], q0[4];\n} NAME_state;")
+    struct = (f"typedef struct {{\n    NAME_real h, period;\n{fields}\n"
+              "    NAME_real pos[3], v[3], q[4], hist[3][12];\n    int nh;\n"
+              "    NAME_real pos0[3], v0[3], q0[4];\n} NAME_state;")
     guard = name.upper() + "_H"
     header = f"""/* {name}.h — generated by strapdown export-c. Do not edit.
  * Navigation on the WGS-84 Earth (NED): coning, rotation and sculling compensated body
@@ -418,7 +427,7 @@ def generate_nav(structure: str, n: int, name: str, update_helpers: str) -> tupl
 #ifndef {guard}
 #define {guard}
 
-typedef double real_t;
+typedef double NAME_real;
 
 {struct}
 {_API}
@@ -431,4 +440,4 @@ typedef double real_t;
 #include <math.h>
 #include "{name}.h"
 {update_helpers}{_helpers()}{_step()}{init}{body}"""
-    return header.replace("NAME", name), source.replace("NAME", name), ops
+    return fill_names(header, name), fill_names(source, name), ops
