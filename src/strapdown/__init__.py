@@ -27,6 +27,15 @@ Units and arrays
     SI and radians inside; degrees only in names that say so. Vectors
     ``(..., 3)``, quaternions ``(..., 4)``, DCMs ``(..., 3, 3)``; time series
     put time first. float64 throughout.
+Navigation
+    :func:`navigate` (and :class:`NavStream`, the same over a log fed in chunks, bit for
+    bit) on the WGS-84 Earth in NED: gyro (rad) and accelerometer (m/s) increments, each
+    covering the interval that *ends* at its stamp, so the first increment of a log
+    stamped ``t_1`` starts at ``t₀ = t_1 − h``, the time of the initial state (position
+    in rad and m above the ellipsoid, NED velocity, ``q_n_b``). The :class:`NavSolution`
+    holds row 0 = that initial state, then one row per update stamped at its end.
+    ``strapdown nav`` writes the same rows with the z-y-x Euler angles (deg) beside the
+    quaternion; from a rate log ``t₀`` is the first sample's stamp.
 Errors
     ``δq = q_est ⊗ q_true*`` (reference frame), ``δφ_n = log δq``, angle
     ``2 atan2(|vec δq|, |w δq|)``. Drift rate: least-squares slope of the error
@@ -54,7 +63,8 @@ Layout (imports point only down this list; ``make lint`` enforces it)
 ``algorithms``
     the algorithm model (:class:`AlgorithmSpec` and its registry), coning sets, update
     structures, rate-input and quaternion algorithms, cone kinematics, streaming, the
-    arbitrary-precision path, the compiled kernels and their plain-Python twin.
+    velocity and navigation updates (``navigate``), the arbitrary-precision path, the
+    compiled kernels and their plain-Python twin.
 ``truth``, ``io``
     reference motions, sensor and trajectory models; log readers and file output.
 ``rotation``
@@ -92,6 +102,10 @@ _EXPORTS = {
     "rotation_vectors": "strapdown.algorithms.coning",
     "rate_attitude": "strapdown.algorithms.rate",
     "RotvecStream": "strapdown.algorithms.streaming",
+    # navigation on the WGS-84 Earth (NED)
+    "navigate": "strapdown.algorithms.navigation",
+    "NavStream": "strapdown.algorithms.navigation",
+    "NavSolution": "strapdown.algorithms.navigation",
     # the AHRS
     "AhrsConfig": "strapdown.ahrs",
     "ekf": "strapdown.ahrs",

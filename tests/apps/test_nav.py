@@ -72,16 +72,17 @@ def test_increment_log_through_the_cli_equals_the_library_and_the_truth(tmp_path
                  "2", "--out", str(out)]) == 0
     assert "wrote" in capsys.readouterr().out
     rows = _read_out(out)
-    assert rows.shape == (g.shape[0] // 2, 11)  # one row per update, no initial row
+    # the initial state (at the first stamp - h), then one row per update
+    assert rows.shape == (g.shape[0] // 2 + 1, len(NAV_COLUMNS))
     # the library on the same increments; the initial attitude went through yaw/pitch/roll
     # in decimal, so agreement is to round-off, not bit for bit
     sol = navigate(g, a, 2, h=H, lat=math.radians(52.0), lon=math.radians(-3.0), height=350.0,
                    v0=s0.velocity[0], q0=s0.q[0])
-    assert np.allclose(rows[:, 0], sol.t[1:], rtol=0, atol=1e-12)
-    assert np.allclose(np.radians(rows[:, 1:3]), np.column_stack([sol.lat, sol.lon])[1:],
+    assert np.allclose(rows[:, 0], sol.t, rtol=0, atol=1e-12)
+    assert np.allclose(np.radians(rows[:, 1:3]), np.column_stack([sol.lat, sol.lon]),
                        rtol=0, atol=1e-14)
-    assert np.allclose(rows[:, 4:7], sol.v[1:], rtol=0, atol=1e-12)
-    assert np.allclose(rows[:, 7:11], sol.q[1:], rtol=0, atol=1e-14)
+    assert np.allclose(rows[:, 4:7], sol.v, rtol=0, atol=1e-12)
+    assert np.allclose(rows[:, 7:11], sol.q, rtol=0, atol=1e-14)
     # ideal increments at 100 Hz, 20 s with a turn and a climb: 0.16 mm, 1.4e-7 m/s
     dp, dv = _position_error(rows)
     assert np.max(np.abs(dp)) < 1e-3 and np.max(np.abs(dv)) < 1e-6
@@ -97,7 +98,9 @@ def test_rate_log_in_deg_s_and_g_navigates_like_the_increments(tmp_path, flight)
     assert main(["nav", "--imu", str(log), *_init_args(s0), "--structure", "single-chain",
                  "--out", str(out), "--no-progress"]) == 0
     rows = _read_out(out)
-    assert rows.shape[0] == edges.size - 1 and rows[0, 0] == pytest.approx(H)
+    # the initial state at the first sample's stamp, then one row per sample interval
+    assert rows.shape[0] == edges.size and rows[0, 0] == 0.0
+    assert rows[1, 0] == pytest.approx(H)
     # the four-sample quadrature of the rates misses the kinks of the ramps' derivatives
     # (1e-5 m/s in the intervals at t = 8 s and 12 s): 1.3 mm, 2.3e-4 m/s
     dp, dv = _position_error(rows)
@@ -126,7 +129,8 @@ def test_streamed_output_equals_one_chunk(tmp_path, flight, monkeypatch, structu
     data = tmp_path / "log.npz"
     np.savez(data, t=edges[1:], gyro=g, accel=a)
     args = ["nav", "--imu", str(data), "--increments", "--units", "rad", "--acc-units", "m/s",
-            *_init_args(s0), "--structure", structure, "--subsamples", "3"]
+            *_init_args(s0), "--structure", structure, "--subsamples", "3", "--trailing",
+            "drop"]  # 2000 increments: 2 short of a conventional update of 3
     assert main([*args, "--out", str(tmp_path / "one.npz")]) == 0
     monkeypatch.setattr(nav_app, "CHUNK", 101)
     assert main([*args, "--out", str(tmp_path / "many.csv")]) == 0

@@ -102,8 +102,8 @@ def test_nav_gap_options_and_sidecar(tmp_path, capsys):
         main(["nav", "--imu", log, *init, "--out", str(tmp_path / "o.csv")])
     assert "--on-gap report bridges gaps up to 1 s" in capsys.readouterr().err
     assert not (tmp_path / "o.csv").exists()
-    assert main(["nav", "--imu", log, *init, "--on-gap", "report", "--out",
-                 str(tmp_path / "o.csv")]) == 0
+    assert main(["nav", "--imu", log, *init, "--on-gap", "report", "--trailing", "drop",
+                 "--out", str(tmp_path / "o.csv")]) == 0  # 1000 samples: 999 intervals
     assert "20 missing sample(s) bridged" in capsys.readouterr().err
     meta = json.loads((tmp_path / "o.csv.meta.json").read_text())
     assert meta["bridged_samples"] == 20

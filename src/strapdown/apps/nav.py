@@ -25,8 +25,27 @@ convention, −180…180° or 0…360°; the output continues from the value giv
 correction of normal gravity stays within 2 % of the inverse-square law there, and is wrong
 beyond), Euler angles within ±360°.
 
-Output: one row per update, ``t,lat_deg,lon_deg,height_m,vn,ve,vd,qw,qx,qy,qz`` (NED,
-``q_n_b``), CSV or ``.npz``; the navigation runs in chunks through
+Trailing samples: the conventional structure updates every N samples; a log whose
+increments do not fill the last update (fewer than N left at the end) is an error naming
+how many are left, unless ``trailing="drop"`` (``--trailing drop``), which navigates
+without them and records how many in the summary. The default is the error because the
+output would otherwise silently end before the log does (the single chain updates every
+sample and never leaves any).
+
+A duplicated first row: an increment log whose first two rows hold identical values (at
+different stamps: a common simulator export repeats the first row, and the extra
+increment costs 145 m in 10 min on a manoeuvre) warns (:class:`DuplicateRowWarning`, in
+the summary's warnings and on stderr). A log whose first rows are all equal (a body at
+rest or in steady motion, simulated without noise) is not flagged: the rows agree because
+the motion does, so only rows 0 and 1 equal with row 2 different warn.
+
+Output: ``t,lat_deg,lon_deg,height_m,vn,ve,vd,qw,qx,qy,qz,yaw_deg,pitch_deg,roll_deg``
+(NED, ``q_n_b`` Hamilton, scalar first, and its z-y-x Euler angles of the body in NED,
+pitch within ±90°, roll 0 at gimbal lock), CSV or ``.npz``. Row 0 is the initial state
+(as :func:`~strapdown.algorithms.navigation.navigate`'s :class:`NavSolution` has), at
+``t0``: for increments the start of the first interval, the first stamp − h (each
+increment's stamp is the end of its interval); for rates the first sample's stamp. Then
+one row per update, ``t`` the end of the update. The navigation runs in chunks through
 :class:`strapdown.algorithms.navigation.NavStream` (bit for bit the one-shot
 :func:`~strapdown.algorithms.navigation.navigate`), each written as it completes to a
 temporary file renamed over the target at the end, so nothing is written on failure.
@@ -74,11 +93,12 @@ from strapdown.io.timing import (
     Timing,
     TimingMode,
 )
-from strapdown.rotation.dcm import quat_from_dcm
-from strapdown.rotation.euler import dcm_from_euler_zyx
+from strapdown.rotation.dcm import dcm_from_quat, quat_from_dcm
+from strapdown.rotation.euler import dcm_from_euler_zyx, euler_zyx_from_dcm
 
 __all__ = ["ACC_UNITS", "HEIGHT_RANGE_M", "MAX_ANGLE_DEG", "MAX_LONGITUDE_DEG",
-           "MAX_SPECIFIC_FORCE", "NAV_COLUMNS", "AccUnit", "NavLog", "increments_from_rates",
+           "MAX_SPECIFIC_FORCE", "NAV_COLUMNS", "TRAILING_POLICIES", "AccUnit",
+           "DuplicateRowWarning", "NavLog", "TrailingPolicy", "increments_from_rates",
            "navigate_log", "read_nav_log"]
 
 #: Accelerometer units: specific force (m/s², g) for rate logs, velocity increments (m/s).
@@ -86,8 +106,14 @@ AccUnit = Literal["m/s2", "g", "m/s"]
 ACC_UNITS: tuple[AccUnit, ...] = get_args(AccUnit)
 _ACC_ALLOWED: dict[InputKind, tuple[AccUnit, ...]] = {"rate": ("m/s2", "g"),
                                                       "increment": ("m/s",)}
-#: Output columns, one row per update.
-NAV_COLUMNS = ("t", "lat_deg", "lon_deg", "height_m", "vn", "ve", "vd", "qw", "qx", "qy", "qz")
+#: Output columns: row 0 the initial state, then one row per update; the Euler angles
+#: (z-y-x of ``q_n_b`` in NED, deg) follow the quaternion.
+NAV_COLUMNS = ("t", "lat_deg", "lon_deg", "height_m", "vn", "ve", "vd", "qw", "qx", "qy", "qz",
+               "yaw_deg", "pitch_deg", "roll_deg")
+#: What ``nav`` does with fewer than N samples left after the last whole conventional
+#: update: fail naming them (default), or navigate without them.
+TrailingPolicy = Literal["error", "drop"]
+TRAILING_POLICIES: tuple[TrailingPolicy, ...] = get_args(TrailingPolicy)
 G0 = 9.80665
 CHUNK = 1 << 15
 #: Largest specific force accepted (m/s², about 10⁶ g: beyond any accelerometer's range,
@@ -99,6 +125,10 @@ HEIGHT_RANGE_M = (-2.0e4, 1.0e6)
 MAX_LONGITUDE_DEG = 360.0
 #: Largest initial Euler angle magnitude (deg).
 MAX_ANGLE_DEG = 360.0
+
+
+class DuplicateRowWarning(UserWarning):
+    """An increment log whose first two rows hold identical values (a duplicated first row)."""
 
 
 @dataclass(frozen=True)
@@ -300,9 +330,29 @@ def read_nav_log(path: str | os.PathLike[str], *, kind: InputKind = "rate",
     t, gyro, acc, h, bridged = _nav_grid(path, log, acc, on_gap)
     _check_acc_range(path, acc, unit, h)
     _check_acc_magnitude(path, acc if kind == "rate" else acc / h, unit, unit_check)
+    if kind == "increment":
+        _check_first_rows(path, t, gyro, acc)
     si = acc * G0 if unit == "g" else acc
     return NavLog(t, gyro, np.ascontiguousarray(si), kind, h, log.units, unit, log.timing,
                   bridged)
+
+
+def _check_first_rows(path: Path, t: NDArray[np.float64], gyro: NDArray[np.float64],
+                      acc: NDArray[np.float64]) -> None:
+    """Warn when the first two increment rows are identical and the third is not (a
+    duplicated first row; see the module docstring)."""
+    if t.size < 2:
+        return
+
+    def same(i: int, j: int) -> bool:
+        return bool(np.array_equal(gyro[i], gyro[j]) and np.array_equal(acc[i], acc[j]))
+
+    if same(0, 1) and (t.size < 3 or not same(1, 2)):
+        warnings.warn(f"{path}: the first two increment rows (t = {t[0]:.9g} s and "
+                      f"{t[1]:.9g} s) hold identical values: a duplicated first row (a common "
+                      "simulator export) adds an interval of motion that is not there (145 m "
+                      "in 10 min on a manoeuvre); drop the first row if it is a copy",
+                      DuplicateRowWarning, stacklevel=3)
 
 
 #: What ``nav`` does at a gap: fail, or bridge it (up to :data:`BRIDGE_MAX_S`).
@@ -407,9 +457,12 @@ def _initial_state(lat_deg: float, lon_deg: float, height: float,
     return math.radians(lat_deg), math.radians(lon_deg), float(height), v, q
 
 
-def _rows(sol) -> NDArray[np.float64]:
-    return np.column_stack([sol.t, np.degrees(sol.lat), np.degrees(sol.lon), sol.height,
-                            sol.v, sol.q])
+def _rows(t, lat, lon, height, v, q) -> NDArray[np.float64]:
+    """Output rows (:data:`NAV_COLUMNS`) of states given as arrays (one per row)."""
+    ypr = (np.column_stack(euler_zyx_from_dcm(dcm_from_quat(q))) if len(t)
+           else np.zeros((0, 3)))
+    return np.column_stack([t, np.degrees(lat), np.degrees(lon), height, v, q,
+                            np.degrees(ypr)])
 
 
 def _check_out(imu: Path, out: Path) -> None:
@@ -429,8 +482,10 @@ def navigate_log(imu: str | os.PathLike[str], out: str | os.PathLike[str], *, la
                  accept_unit_warning: bool = False, progress: bool = False,
                  on_gap: NavGapPolicy = "error", timing: TimingMode = "auto",
                  jitter_tolerance: float = JITTER_TOLERANCE, held: HeldPolicy = "auto",
-                 duplicates: DuplicatePolicy = "error") -> dict[str, Any]:
-    """Navigate a log and write one row per update (see the module docstring).
+                 duplicates: DuplicatePolicy = "error",
+                 trailing: TrailingPolicy = "error") -> dict[str, Any]:
+    """Navigate a log and write the initial state and one row per update (see the module
+    docstring).
 
     Parameters
     ----------
@@ -446,16 +501,23 @@ def navigate_log(imu: str | os.PathLike[str], out: str | os.PathLike[str], *, la
         A progress bar on stderr.
     on_gap, timing, jitter_tolerance, held, duplicates
         The gap policy and the time base (:func:`read_nav_log`).
+    trailing : {"error", "drop"}
+        Fewer than N samples left after the last whole conventional update: an error
+        naming them (default), or navigated without (counted in the summary).
 
     Returns
     -------
     dict
         A summary (also written beside ``out`` as ``OUT.meta.json``): samples,
-        outputs, sample period, units, the time base (the fitted clock and its residuals),
-        bridged samples, warnings.
+        outputs (updates; the file holds one more row, the initial state), sample period,
+        units, the time base (the fitted clock and its residuals), bridged samples,
+        trailing samples dropped, warnings.
     """
     imu_path, out_path = Path(imu), Path(out)
     _check_out(imu_path, out_path)
+    if trailing not in TRAILING_POLICIES:
+        raise InputError(f"trailing must be one of {', '.join(TRAILING_POLICIES)}, got "
+                         f"{trailing!r}")
     lat, lon, hgt, v0, q0 = _initial_state(lat_deg, lon_deg, height, velocity, attitude_deg)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -471,16 +533,23 @@ def navigate_log(imu: str | os.PathLike[str], out: str | os.PathLike[str], *, la
         g, a, t0 = log.gyro, log.accel, float(log.t[0]) - log.h
     stream = NavStream(subsamples, h=log.h, lat=lat, lon=lon, height=hgt, v0=v0, q0=q0,
                        structure=structure, t0=t0, sculling=sculling)
+    left = _trailing(g.shape[0], stream, trailing)
+    first = _rows(np.array([t0]), np.array([lat]), np.array([lon]), np.array([hgt]),
+                  v0[None, :], (q0 / np.linalg.norm(q0))[None, :])  # as navigate's row 0
     from strapdown import __version__
     from strapdown.apps._logs import output_with_sidecar
 
     with output_with_sidecar(out_path) as paired:
-        n_out = _stream_to(paired.path, stream, g, a, progress)
+        n_out = _stream_to(paired.path, stream, g, a, progress, first)
         paired.meta = {
             "input": str(imu_path), "samples": int(log.t.size), "outputs": n_out,
-            "sample_period_s": log.h, "update_period_s": stream.update_period,
+            "rows": n_out + 1, "sample_period_s": log.h,
+            "update_period_s": stream.update_period, "t0_s": t0,
             "units": log.units, "acc_units": log.acc_units, "columns": list(NAV_COLUMNS),
-            "frame": "NED; q_n_b Hamilton, scalar first; t: end of each update interval",
+            "frame": "NED; q_n_b Hamilton, scalar first; yaw, pitch, roll z-y-x of q_n_b "
+                     "(deg); row 0: the initial state at t0 (increments: first stamp - h, "
+                     "rates: first stamp); t: end of each update interval",
+            "trailing": trailing, "trailing_samples_dropped": left,
             "on_gap": on_gap, "bridged_samples": log.bridged,
             "timing": None if log.timing is None else log.timing.to_dict(),
             "time_base": None if log.timing is None else log.timing.describe(),
@@ -488,9 +557,24 @@ def navigate_log(imu: str | os.PathLike[str], out: str | os.PathLike[str], *, la
     return paired.meta
 
 
+def _trailing(k: int, stream: NavStream, policy: TrailingPolicy) -> int:
+    """The samples left after the last whole update of ``k`` increments (the conventional
+    structure's partial update); an error unless ``policy == "drop"``."""
+    per = round(stream.update_period / stream.h)  # samples per update: N, or 1 (every sample)
+    left = k % per
+    if left and k >= per and policy == "error":  # shorter than one update: no update at all
+        raise InputError(f"the log's {k} increments leave {left} sample(s) after the last "
+                         f"whole update of N = {per} ({left * stream.h:.6g} s at its end); pass "
+                         "--trailing drop to navigate without them (or trim the log, or use "
+                         "--structure single-chain, which updates every sample); nothing "
+                         "written")
+    return left
+
+
 def _stream_to(out: Path, stream: NavStream, g: NDArray[np.float64], a: NDArray[np.float64],
-               progress: bool) -> int:
-    """Feed the increments in chunks, writing each chunk's rows as they come."""
+               progress: bool, first: NDArray[np.float64]) -> int:
+    """Write the initial-state row ``first``, then feed the increments in chunks, writing
+    each chunk's rows as they come; returns the number of updates."""
     csv_out = out.suffix.lower() == ".csv"
     parts, n_out = [], 0
     tmp = out  # a temporary path beside the target (output_with_sidecar renames it)
@@ -499,10 +583,13 @@ def _stream_to(out: Path, stream: NavStream, g: NDArray[np.float64], a: NDArray[
                  file=sys.stderr) as bar:
         if csv_out:
             f.write(",".join(NAV_COLUMNS) + "\n")
+            np.savetxt(f, first, delimiter=",", fmt="%.17g")
+        else:
+            parts.append(first)
         for s in range(0, g.shape[0], CHUNK):
             sol = stream.feed(g[s:s + CHUNK], a[s:s + CHUNK])
             bar.update(min(CHUNK, g.shape[0] - s))
-            rows = _rows(sol)
+            rows = _rows(sol.t, sol.lat, sol.lon, sol.height, sol.v, sol.q)
             if not np.all(np.isfinite(rows)):
                 i = int(np.argmax(~np.all(np.isfinite(rows), axis=1)))
                 raise InputError(f"the navigation diverged (NaN or infinity) at t = "

@@ -25,18 +25,23 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         help="navigate a gyro + accelerometer log on the WGS-84 Earth (NED)",
         description="Validate a gyro and accelerometer log, navigate it from the initial "
         "position, velocity and attitude (coning and sculling compensated, NED on WGS-84) and "
-        "write t,lat_deg,lon_deg,height_m,vn,ve,vd,qw,qx,qy,qz, one row per update, "
+        "write t,lat_deg,lon_deg,height_m,vn,ve,vd,qw,qx,qy,qz,yaw_deg,pitch_deg,roll_deg "
         "atomically, with OUT.meta.json (the time base: the sensor's clock fitted to the "
         "stamps and its residuals). Frames: n = NED (north, east, down), q_n_b rotates body "
-        "vectors into it (Hamilton, scalar first); each increment's stamp is the end of its "
-        "interval, t of a row the end of its update.")
+        "vectors into it (Hamilton, scalar first), yaw/pitch/roll its z-y-x Euler angles (deg). "
+        "Each increment's stamp is the end of its interval. Row 0 is the initial state, at "
+        "t0 = the first stamp - h for increments (the start of the first interval) or the "
+        "first stamp for rates; then one row per update, t the end of the update. An "
+        "increment log whose first two rows are identical (a duplicated first row) warns; "
+        "fewer than N samples left after the last whole update are an error unless "
+        "--trailing drop.")
     p.set_defaults(handler=run)
     return p
 
 
 def _arguments(p: argparse.ArgumentParser) -> None:
     from strapdown.algorithms.velocity import NAV_STRUCTURES
-    from strapdown.apps.nav import ACC_UNITS
+    from strapdown.apps.nav import ACC_UNITS, TRAILING_POLICIES
     from strapdown.io.readers import INCREMENT_UNITS, RATE_UNITS
 
     g = p.add_argument_group("log")
@@ -88,6 +93,10 @@ def _arguments(p: argparse.ArgumentParser) -> None:
                    help="N of the coning and sculling corrections (1-6)")
     a.add_argument("--no-sculling", dest="sculling", action="store_false",
                    help="drop the sculling correction (rotation compensation only)")
+    a.add_argument("--trailing", choices=TRAILING_POLICIES, default="error",
+                   help="fewer than N samples left after the last whole conventional update: "
+                   "error (default: the output would end before the log), or drop them "
+                   "(counted in OUT.meta.json)")
     o = p.add_argument_group("output")
     progress_args(o)
     o.add_argument("--out", required=True, help="output .csv or .npz")
@@ -105,9 +114,12 @@ def run(args: argparse.Namespace) -> int:
                        sample_rate_hz=args.sample_rate_hz, subsamples=args.subsamples,
                        structure=args.structure, sculling=args.sculling,
                        accept_unit_warning=args.accept_unit_warning, progress=progress(args),
-                       on_gap=args.on_gap, **timing_options(args))
+                       on_gap=args.on_gap, trailing=args.trailing, **timing_options(args))
     for w in res["warnings"]:
         say(f"warning: {w}")
+    if res["trailing_samples_dropped"]:
+        say(f"note: {res['trailing_samples_dropped']} trailing sample(s) short of a whole "
+            "update not navigated (--trailing drop)")
     if res["bridged_samples"]:
         say(f"warning: {res['bridged_samples']} missing sample(s) bridged by interpolation")
     base = f"; {res['time_base']}" if res["time_base"] else ""
