@@ -117,25 +117,26 @@ def test_identical_rows_of_a_steady_start_do_not_warn(tmp_path, capsys):
     assert "identical" not in capsys.readouterr().err and not meta["warnings"]
 
 
-def test_a_trailing_partial_update_is_an_error_unless_dropped(tmp_path, flight, capsys):
+def test_a_trailing_partial_update_is_dropped_and_said_or_an_error(tmp_path, flight, capsys):
     edges, g, a = flight
     log = _write_csv(tmp_path / "log.csv", INC, edges[1:], g, a)  # 500 increments
     before = sorted(tmp_path.iterdir())
     with pytest.raises(SystemExit) as exc:
-        main(["nav", "--imu", log, "--increments", *INIT, "--subsamples", "3", "--out",
-              str(tmp_path / "n.csv")])
+        main(["nav", "--imu", log, "--increments", *INIT, "--subsamples", "3", "--trailing",
+              "error", "--out", str(tmp_path / "n.csv")])
     err = capsys.readouterr().err
     assert exc.value.code == 2 and err.count("\n") == 1
     assert "leave 2 sample(s)" in err and "N = 3" in err and "--trailing drop" in err
     assert sorted(tmp_path.iterdir()) == before  # nothing written
-    path, meta = _nav(tmp_path, log, "--subsamples", "3", "--trailing", "drop")
+    path, meta = _nav(tmp_path, log, "--subsamples", "3")  # the default drops, and says so
     assert meta["trailing_samples_dropped"] == 2 and meta["outputs"] == 166
+    assert meta["trailing"] == "drop"
     assert np.load(path)["t"].size == 167
     assert "2 trailing sample(s)" in capsys.readouterr().err
     # whole updates, and the single chain (an update every sample), leave nothing
     for extra in (["--subsamples", "4"], ["--structure", "single-chain", "--subsamples", "3"]):
         _, meta = _nav(tmp_path, log, *extra)
-        assert meta["trailing_samples_dropped"] == 0 and meta["trailing"] == "error"
+        assert meta["trailing_samples_dropped"] == 0 and meta["trailing"] == "drop"
 
 
 def test_help_states_the_output_conventions(capsys):

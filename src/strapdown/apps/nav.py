@@ -25,12 +25,12 @@ convention, −180…180° or 0…360°; the output continues from the value giv
 correction of normal gravity stays within 2 % of the inverse-square law there, and is wrong
 beyond), Euler angles within ±360°.
 
-Trailing samples: the conventional structure updates every N samples; a log whose
-increments do not fill the last update (fewer than N left at the end) is an error naming
-how many are left, unless ``trailing="drop"`` (``--trailing drop``), which navigates
-without them and records how many in the summary. The default is the error because the
-output would otherwise silently end before the log does (the single chain updates every
-sample and never leaves any).
+Trailing samples: the conventional structure updates every N samples; increments that do
+not fill the last update (fewer than N left at the end) are dropped and counted in the
+summary, and the command line says so on stderr (``trailing="drop"``, the default: a
+rate log of n samples gives n − 1 increments, so half of all logs leave one), or they
+are an error naming how many are left (``trailing="error"``, ``--trailing error``). They
+were dropped silently before. The single chain updates every sample and never leaves any.
 
 A duplicated first row: an increment log whose first two rows hold identical values (at
 different stamps: a common simulator export repeats the first row, and the extra
@@ -483,7 +483,7 @@ def navigate_log(imu: str | os.PathLike[str], out: str | os.PathLike[str], *, la
                  on_gap: NavGapPolicy = "error", timing: TimingMode = "auto",
                  jitter_tolerance: float = JITTER_TOLERANCE, held: HeldPolicy = "auto",
                  duplicates: DuplicatePolicy = "error",
-                 trailing: TrailingPolicy = "error") -> dict[str, Any]:
+                 trailing: TrailingPolicy = "drop") -> dict[str, Any]:
     """Navigate a log and write the initial state and one row per update (see the module
     docstring).
 
@@ -501,9 +501,9 @@ def navigate_log(imu: str | os.PathLike[str], out: str | os.PathLike[str], *, la
         A progress bar on stderr.
     on_gap, timing, jitter_tolerance, held, duplicates
         The gap policy and the time base (:func:`read_nav_log`).
-    trailing : {"error", "drop"}
-        Fewer than N samples left after the last whole conventional update: an error
-        naming them (default), or navigated without (counted in the summary).
+    trailing : {"drop", "error"}
+        Fewer than N samples left after the last whole conventional update: navigated
+        without (counted in the summary; default), or an error naming them.
 
     Returns
     -------
@@ -559,15 +559,15 @@ def navigate_log(imu: str | os.PathLike[str], out: str | os.PathLike[str], *, la
 
 def _trailing(k: int, stream: NavStream, policy: TrailingPolicy) -> int:
     """The samples left after the last whole update of ``k`` increments (the conventional
-    structure's partial update); an error unless ``policy == "drop"``."""
+    structure's partial update); an error when ``policy == "error"``."""
     per = round(stream.update_period / stream.h)  # samples per update: N, or 1 (every sample)
     left = k % per
     if left and k >= per and policy == "error":  # shorter than one update: no update at all
         raise InputError(f"the log's {k} increments leave {left} sample(s) after the last "
-                         f"whole update of N = {per} ({left * stream.h:.6g} s at its end); pass "
-                         "--trailing drop to navigate without them (or trim the log, or use "
-                         "--structure single-chain, which updates every sample); nothing "
-                         "written")
+                         f"whole update of N = {per} ({left * stream.h:.6g} s at its end) "
+                         "(--trailing error); the default --trailing drop navigates without "
+                         "them (or use --structure single-chain, which updates every "
+                         "sample); nothing written")
     return left
 
 

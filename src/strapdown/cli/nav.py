@@ -33,8 +33,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         "t0 = the first stamp - h for increments (the start of the first interval) or the "
         "first stamp for rates; then one row per update, t the end of the update. An "
         "increment log whose first two rows are identical (a duplicated first row) warns; "
-        "fewer than N samples left after the last whole update are an error unless "
-        "--trailing drop.")
+        "fewer than N samples left after the last whole update are dropped and said so "
+        "(--trailing error refuses them).")
     p.set_defaults(handler=run)
     return p
 
@@ -93,10 +93,11 @@ def _arguments(p: argparse.ArgumentParser) -> None:
                    help="N of the coning and sculling corrections (1-6)")
     a.add_argument("--no-sculling", dest="sculling", action="store_false",
                    help="drop the sculling correction (rotation compensation only)")
-    a.add_argument("--trailing", choices=TRAILING_POLICIES, default="error",
+    a.add_argument("--trailing", choices=TRAILING_POLICIES, default="drop",
                    help="fewer than N samples left after the last whole conventional update: "
-                   "error (default: the output would end before the log), or drop them "
-                   "(counted in OUT.meta.json)")
+                   "drop them, said on stderr and counted in OUT.meta.json (default: a rate "
+                   "log of n samples gives n - 1 increments, so half of all logs leave one), "
+                   "or refuse the log (error)")
     o = p.add_argument_group("output")
     progress_args(o)
     o.add_argument("--out", required=True, help="output .csv or .npz")
