@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING, cast
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from strapdown._core.validation import as_quaternions, as_vectors, finite_array, positive
+from strapdown._core.validation import as_vectors, finite_array, positive
 from strapdown.algorithms import _kernels
 from strapdown.algorithms.coning import CoefficientSet, triple_arrays
 from strapdown.algorithms.family import IncrementStructure
@@ -31,6 +31,7 @@ from strapdown.algorithms.structures import (
     STRUCTURES,
     AttitudeSolution,
     _run_windowed,
+    _unit_q0,
     single_chain_coefficients,
     single_chain_table,
     stack_sets,
@@ -83,12 +84,7 @@ class RotvecStream:
         self.coefficients = coefficients
         self.h = positive(h, "h (sample interval)")
         self.t0 = float(finite_array(t0, "t0"))
-        if q0 is None:
-            q0 = np.array([1.0, 0.0, 0.0, 0.0])
-        q0 = as_quaternions(q0, "q0")
-        if q0.shape != (4,):
-            raise ValueError(f"q0 must have shape (4,), got {q0.shape}")
-        self._q0 = q0 / np.linalg.norm(q0)
+        self._q0 = _unit_q0(q0)
         self.n = coefficients.n
         self._triple = triple_arrays(coefficients.triples)
         if structure == "single-chain":
@@ -233,12 +229,7 @@ class RateStream:
         self.spec = spec
         self.td = positive(td, "td (sample period)")
         self.t0 = float(finite_array(t0, "t0"))
-        if q0 is None:
-            q0 = np.array([1.0, 0.0, 0.0, 0.0])
-        q0 = as_quaternions(q0, "q0")
-        if q0.shape != (4,):
-            raise ValueError(f"q0 must have shape (4,), got {q0.shape}")
-        self._q0 = q0 / np.linalg.norm(q0)
+        self._q0 = _unit_q0(q0)
         self._sliding = spec.structure == "sliding"
         self._rk4 = isinstance(fam, Rk4)
         if self._rk4:

@@ -141,12 +141,10 @@ def _record(log: ImuLog, c: slice, mode: str, min_samples: int) -> RateRecord:
                          f"{min_samples}")
     base = float(log.t[0])
     if mode == "resample" or not timing.on_clock:
-        p = clock.period if clock.kind != "irregular" else float(np.median(np.diff(t)))
-        m = int(np.floor((t[-1] - t[0]) / p * (1 + 1e-12))) + 1
-        if m < min_samples:
-            raise ValueError(f"the resampled record has {m} samples; this algorithm needs at "
-                             f"least {min_samples}")
-        grid = t[0] + np.arange(m) * p
+        grid, p = clock.resample_grid(t)
+        if grid.size < min_samples:
+            raise ValueError(f"the resampled record has {grid.size} samples; this algorithm "
+                             f"needs at least {min_samples}")
         return RateRecord(grid, resample_uniform(t, w, grid), p, stamps=t, resampled=True,
                           measured_jitter=clock.residual_max / clock.period)
     ticks = clock.ticks[c]

@@ -51,7 +51,6 @@ from strapdown.io import (
 )
 from strapdown.io.readers import (
     ACC_COLUMNS,
-    EPOCH_LIKE_S,
     GYRO_COLUMNS,
     MAG_COLUMNS,
     ImuLog,
@@ -60,19 +59,18 @@ from strapdown.io.readers import (
     check_finite_rows,
     check_motion,
     check_read_options,
-    check_stamp_steps,
     default_columns,
     input_file,
+    read_time_base,
     time_scale,
 )
 from strapdown.io.timing import (
+    BRIDGE_MAX_S,
     JITTER_TOLERANCE,
     DuplicatePolicy,
     HeldPolicy,
     Timing,
     TimingMode,
-    reconstruct,
-    relative_times,
 )
 from strapdown.rotation.dcm import dcm_from_quat
 from strapdown.rotation.euler import euler_zyx_from_dcm
@@ -211,20 +209,16 @@ def read_ahrs_log(path, *, gyro_units: str | None = None, acc_units: str | None 
         raise InputError(f"{path}: {raw.size} samples; at least 2 are needed")
     check_finite_rows(path, [("time", [raw]), ("gyro", [g]), ("accelerometer", [a]),
                              *((("magnetometer", [m]),) if m is not None else ())])
-    check_stamp_steps(path, raw, scale)
-    base = relative_times(raw, scale)
     values = np.column_stack([g, a] + ([m] if m is not None else []))
-    timing = reconstruct(path, base, values, period=nominal, mode=timing_mode, held=held,
-                         duplicates=duplicates, jitter_tolerance=jitter_tolerance,
-                         fit=path.suffix.lower() != ".mat")
+    timing, t, t_rel = read_time_base(path, raw, scale, values, period=nominal,
+                                      timing_mode=timing_mode, held=held,
+                                      duplicates=duplicates,
+                                      jitter_tolerance=jitter_tolerance,
+                                      fit=path.suffix.lower() != ".mat")
     keep = timing.cleaning.keep
     if keep.size < raw.size:
         g, a = g[keep], a[keep]
         m = None if m is None else m[keep]
-    if keep.size < 2:
-        raise InputError(f"{path}: {keep.size} distinct samples; at least 2 are needed")
-    t_rel = base.t[keep]
-    t = base.origin + t_rel if abs(base.origin) >= EPOCH_LIKE_S else raw[keep] * scale
     inferred: dict[str, str] = {}
     if found["accelerometer"] is None and acc_units is None:
         acc_units = infer_acc_units(path, a)
@@ -242,20 +236,14 @@ def read_ahrs_log(path, *, gyro_units: str | None = None, acc_units: str | None 
     warn_implausible_rate(path, g, gu, suggestion="deg/s", action=unit_check)
     if m is not None and use_magnetometer:
         _check_gyro_scale(path, t_rel, g, m, gu, unit_check)
-    d = np.diff(t_rel)
-    clock = timing.clock
-    unit_h = nominal or (clock.period if clock is not None and timing.on_clock
-                         else float(np.median(d)))
+    unit_h = nominal or timing.sample_period(t_rel)
     check_motion(path, g, "rate", unit_h)
     _check_range(path, "accelerometer", a, ACC_LIMIT, "m/s²")
     if m is not None:
         _check_range(path, "magnetometer", m, MAG_LIMIT, "(its unit)")
     if m is not None and not np.any(m):
         use_magnetometer = False
-    if clock is not None and timing.on_clock:
-        gaps = [int(timing.rows[i]) for i in clock.gap_rows()]
-    else:
-        gaps = [int(timing.rows[i + 1]) for i in np.flatnonzero(d > gap_tolerance * unit_h)]
+    gaps = timing.gap_rows(t_rel, unit_h, gap_tolerance)
     return AhrsLog(t, np.ascontiguousarray(g), np.ascontiguousarray(a),
                    None if (m is None or not use_magnetometer) else np.ascontiguousarray(m),
                    gu, au, gaps, nominal, timing, inferred)
@@ -373,13 +361,6 @@ def _merge(parts: list[AhrsResult], starts: list[int]) -> AhrsResult:
     return dataclasses.replace(parts[0], **cat)
 
 
-#: Longest gap (s) the filter bridges without ``--on-gap split``: over a gap the gyro is
-#: interpolated linearly between the samples either side (the attitude propagated across
-#: the actual interval) and the accelerometer and magnetometer likewise; their error grows
-#: with the motion the gap hides, so longer gaps are refused.
-BRIDGE_MAX_S = 1.0
-
-
 def _select(res: AhrsResult, rows: np.ndarray, t: np.ndarray) -> AhrsResult:
     """The rows ``rows`` of a result over a bridged grid, at the times ``t``."""
     cut: dict[str, Any] = {}
@@ -400,36 +381,29 @@ def _bridge(imu: Path, log: AhrsLog, algorithm: str, frame: str,
     timing = log.timing
     assert timing is not None and timing.clock is not None
     clock = timing.clock
-    ticks = clock.ticks
-    lengths = clock.gap_lengths()
-    if lengths.size and lengths.max() * clock.period > BRIDGE_MAX_S:
-        i = int(np.argmax(lengths))
-        row = int(timing.rows[clock.gap_rows()[i]])
-        raise InputError(f"{imu}: a gap of {int(lengths[i])} missing samples "
-                         f"({lengths[i] * clock.period:.3g} s) before data row {row}, longer "
-                         f"than the {BRIDGE_MAX_S:g} s the filter bridges; pass --on-gap split "
-                         "(each segment filtered from the previous one's last attitude)")
+    gap = clock.longest_gap()
+    if gap is not None and gap[1] * clock.period > BRIDGE_MAX_S:
+        raise InputError(f"{imu}: a gap of {gap[1]} missing samples "
+                         f"({gap[1] * clock.period:.3g} s) before data row "
+                         f"{int(timing.rows[gap[0]])}, longer than the {BRIDGE_MAX_S:g} s the "
+                         "filter bridges; pass --on-gap split (each segment filtered from "
+                         "the previous one's last attitude)")
     origin = timing.base.origin
-    uniform = clock.kind == "uniform" and not lengths.size and log.nominal_period is None
+    uniform = clock.kind == "uniform" and gap is None and log.nominal_period is None
     if uniform:
-        full, t_grid = ticks, log.t
+        t_grid = log.t
         gyro, acc, mag = log.gyro, log.acc, log.mag
     else:
-        full = np.arange(int(ticks[-1]) + 1)
+        full, (gyro_b, acc_b, mag) = clock.bridge(log.gyro, log.acc, log.mag)
+        assert gyro_b is not None and acc_b is not None
+        gyro, acc = gyro_b, acc_b
         t_grid = origin + clock.uniform_times(full)
-
-        def fill(x):
-            if x is None or not lengths.size:
-                return x
-            return np.column_stack([np.interp(full, ticks, x[:, j]) for j in range(3)])
-
-        gyro, acc, mag = fill(log.gyro), fill(log.acc), fill(log.mag)
     r = (offline_ekf if offline else ekf)(t_grid, gyro, acc, mag, algorithm=algorithm,
                                           config=config, frame=frame)
     _check_output(r, log.gyro_units)
     if uniform:
         return r
-    return _select(r, ticks, origin + clock.times())
+    return _select(r, clock.ticks, origin + clock.times())
 
 
 def _filter(imu: Path, log: AhrsLog, algorithm: str, frame: str, config: AhrsConfig | None,
@@ -438,7 +412,8 @@ def _filter(imu: Path, log: AhrsLog, algorithm: str, frame: str, config: AhrsCon
     recording; ``(result, segment per output, time base)``.
 
     Samples on the fitted sensor clock (:attr:`strapdown.io.timing.Timing.on_clock`) run on
-    its grid, gaps up to :data:`BRIDGE_MAX_S` bridged (:func:`_bridge`) unless ``split``;
+    its grid, gaps up to :data:`strapdown.io.timing.BRIDGE_MAX_S` bridged
+    (:func:`_bridge`) unless ``split``;
     otherwise (``resample``, irregular sampling, ``--timing stamps``, ``split``) each
     gap-free segment runs on its uniform record (:func:`strapdown.apps._logs.rate_records`),
     from the previous segment's last attitude and bias.
@@ -485,10 +460,11 @@ def run_ahrs(imu, out, *, algorithm: str = "rate-single", frame: str = "ENU",
     forward and backward and the two combined, acausal (every estimate uses the whole
     recording); the metadata's ``mode`` says which.
 
-    ``on_gap``: ``"report"`` bridges gaps of up to :data:`BRIDGE_MAX_S` on the sensor's
-    fitted clock (reported; longer ones are an error), ``"split"`` filters each gap-free
-    segment from the previous one's last attitude and bias (covariance reset; the motion
-    during the gap is not observed), ``"error"`` fails at a gap. ``timing``,
+    ``on_gap``: ``"report"`` bridges gaps of up to
+    :data:`strapdown.io.timing.BRIDGE_MAX_S` on the sensor's fitted clock (reported;
+    longer ones are an error), ``"split"`` filters each gap-free segment from the previous
+    one's last attitude and bias (covariance reset; the motion during the gap is not
+    observed), ``"error"`` fails at a gap. ``timing``,
     ``jitter_tolerance``, ``held``, ``duplicates``: the time base
     (:func:`read_ahrs_log`); ``resample`` is ``timing="resample"``: gyro, accelerometer
     and magnetometer interpolated onto the uniform grid. ``delimiter``: a CSV's (default:

@@ -87,6 +87,7 @@ from strapdown.io.readers import (
     default_columns,
 )
 from strapdown.io.timing import (
+    BRIDGE_MAX_S,
     JITTER_TOLERANCE,
     DuplicatePolicy,
     HeldPolicy,
@@ -292,8 +293,9 @@ def read_nav_log(path: str | os.PathLike[str], *, kind: InputKind = "rate",
         What magnitudes that suggest the other unit do (gyro and accelerometer).
     on_gap : {"error", "report"}
         A gap (samples missing on the sensor's fitted clock): an error, or bridged by
-        linear interpolation of both sensors when no longer than :data:`BRIDGE_MAX_S`
-        (reported; the navigation error grows with what the gap hides).
+        linear interpolation of both sensors when no longer than
+        :data:`strapdown.io.timing.BRIDGE_MAX_S` (reported; the navigation error grows with
+        what the gap hides).
     timing, jitter_tolerance, held, duplicates
         The time base, as for :func:`strapdown.io.read_imu` (``timing="resample"``
         interpolates both sensors onto a uniform grid, a cubic spline).
@@ -355,13 +357,10 @@ def _check_first_rows(path: Path, t: NDArray[np.float64], gyro: NDArray[np.float
                       DuplicateRowWarning, stacklevel=3)
 
 
-#: What ``nav`` does at a gap: fail, or bridge it (up to :data:`BRIDGE_MAX_S`).
+#: What ``nav`` does at a gap: fail, or bridge it (up to
+#: :data:`strapdown.io.timing.BRIDGE_MAX_S`).
 NavGapPolicy = Literal["error", "report"]
 NAV_GAP_POLICIES: tuple[NavGapPolicy, ...] = get_args(NavGapPolicy)
-#: Longest gap (s) ``nav --on-gap report`` bridges by interpolation.
-BRIDGE_MAX_S = 1.0
-
-
 def _nav_grid(path: Path, log, acc: NDArray[np.float64], on_gap: str):
     """``(t, gyro, acc, h, bridged)`` on a uniform grid: the fitted sensor clock (gaps
     bridged by linear interpolation), a uniform-stamp check (``timing="stamps"``), or both
@@ -372,36 +371,26 @@ def _nav_grid(path: Path, log, acc: NDArray[np.float64], on_gap: str):
         return log.t, log.data, acc, _uniform_period(path, log.t, log.nominal_period), 0
     p = clock.period
     if timing.on_clock:
-        ticks = clock.ticks
-        lengths = clock.gap_lengths()
-        if lengths.size and (on_gap == "error" or lengths.max() * p > BRIDGE_MAX_S):
-            i = int(np.argmax(lengths))
-            row = int(timing.rows[clock.gap_rows()[i]])
+        gap = clock.longest_gap()
+        if gap is not None and (on_gap == "error" or gap[1] * p > BRIDGE_MAX_S):
             raise InputError(
-                f"{path}: a gap of {int(lengths[i])} missing samples ({lengths[i] * p:.3g} s) "
-                f"before data row {row}; " + (
+                f"{path}: a gap of {gap[1]} missing samples ({gap[1] * p:.3g} s) "
+                f"before data row {int(timing.rows[gap[0]])}; " + (
                     "--on-gap report bridges gaps up to "
                     f"{BRIDGE_MAX_S:g} s by interpolation" if on_gap == "error" else
                     f"longer than the {BRIDGE_MAX_S:g} s --on-gap report bridges; split the "
                     "log at the gap"))
-        if clock.kind == "uniform" and not lengths.size and log.nominal_period is None:
+        if clock.kind == "uniform" and gap is None and log.nominal_period is None:
             return log.t, log.data, acc, p, 0
-        full = np.arange(int(ticks[-1]) + 1)
-        t = float(log.t[0]) + (clock.uniform_times(full) - clock.uniform_times(ticks[:1])[0])
-        if not lengths.size:
-            return t, log.data, acc, p, 0
-
-        def fill(x):
-            return np.column_stack([np.interp(full, ticks, x[:, j]) for j in range(3)])
-
-        return t, fill(log.data), fill(acc), p, int(full.size - ticks.size)
+        full, (gyro, acc_b) = clock.bridge(log.data, acc)
+        assert gyro is not None and acc_b is not None
+        t = float(log.t[0]) + (clock.uniform_times(full)
+                               - clock.uniform_times(clock.ticks[:1])[0])
+        return t, gyro, acc_b, p, clock.missing
     from strapdown.algorithms.rate import resample_uniform
 
-    ts = log.t
-    step = p if clock.kind != "irregular" else float(np.median(np.diff(ts)))
-    m = int(np.floor((ts[-1] - ts[0]) / step * (1 + 1e-12))) + 1
-    grid = ts[0] + np.arange(m) * step
-    return (grid, resample_uniform(ts, log.data, grid), resample_uniform(ts, acc, grid),
+    grid, step = clock.resample_grid(log.t)
+    return (grid, resample_uniform(log.t, log.data, grid), resample_uniform(log.t, acc, grid),
             step, 0)
 
 

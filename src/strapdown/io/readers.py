@@ -109,6 +109,7 @@ __all__ = [
     "log_kind",
     "npy_log",
     "read_imu",
+    "read_time_base",
     "time_scale",
     "warn_implausible_rate",
     "write_attitude",
@@ -878,31 +879,20 @@ def read_imu(path: str | os.PathLike[str], *, kind: InputKind | None, units: Gyr
     if raw.size < 2:
         raise InputError(f"{path}: {raw.size} samples; at least 2 are needed")
     check_finite_rows(path, [(None, [raw, g])])
-    check_stamp_steps(path, raw, src.scale)
     stamped = src.what != "BROAD's imu_gyr"  # BROAD's times come from its rate
     nominal = 1.0 / sample_rate_hz if sample_rate_hz is not None and stamped else None
-    base = relative_times(raw, src.scale)
-    timing = reconstruct(path, base, g, period=nominal, mode=timing_mode, held=held,
-                         duplicates=duplicates, jitter_tolerance=jitter_tolerance,
-                         fit=stamped)
+    timing, t, t_rel = read_time_base(path, raw, src.scale, g, period=nominal,
+                                      timing_mode=timing_mode, held=held,
+                                      duplicates=duplicates,
+                                      jitter_tolerance=jitter_tolerance, fit=stamped)
     keep = timing.cleaning.keep
     if keep.size < raw.size:
         g = g[keep]
-    t_rel = base.t[keep]
-    # stamps as read (scaled) unless they are epoch-like, where only the exact relative
-    # times keep the intervals (the origin is kept in the timing record)
-    t = base.origin + t_rel if abs(base.origin) >= EPOCH_LIKE_S else raw[keep] * src.scale
-    if keep.size < 2:
-        raise InputError(f"{path}: {keep.size} distinct samples; at least 2 are needed")
     d = np.diff(t_rel)
     check_steps(path, d, t_rel)
-    clock = timing.clock
-    h = clock.period if clock is not None and timing.on_clock else float(np.median(d))
+    h = timing.sample_period(t_rel)
     unit_h = nominal or h
-    if clock is not None and timing.on_clock:
-        gaps = [int(timing.rows[i]) for i in clock.gap_rows()]
-    else:
-        gaps = [int(timing.rows[i + 1]) for i in np.flatnonzero(d > gap_tolerance * unit_h)]
+    gaps = timing.gap_rows(t_rel, unit_h, gap_tolerance)
     if gaps and on_gap == "error":
         i = int(np.searchsorted(timing.rows, gaps[0]))
         raise InputError(f"{path}: gap of {d[i - 1]:.6g} s ({d[i - 1] / unit_h:.1f} sample "
@@ -938,6 +928,33 @@ def check_stamp_steps(path: str | os.PathLike[str], raw: NDArray[np.float64],
         raise InputError(f"{path}: time step of {float(d[i])!r} s before data row {i + 2}; "
                          f"steps must be finite and at least {MIN_PERIOD:g} s (check the time "
                          "unit)")
+
+
+def read_time_base(path: str | os.PathLike[str], raw: NDArray[np.float64], scale: float,
+                   values: NDArray[np.float64], *, period: float | None,
+                   timing_mode: TimingMode, held: HeldPolicy, duplicates: DuplicatePolicy,
+                   jitter_tolerance: float, fit: bool = True
+                   ) -> tuple[Timing, NDArray[np.float64], NDArray[np.float64]]:
+    """A recording's time base from its stamps ``raw`` (in units of ``scale`` seconds,
+    finite) and sensor columns ``values``: ``(timing, t, t_rel)``, the times of the samples
+    kept (:func:`strapdown.io.timing.reconstruct`) in seconds as read — or, for epoch-like
+    stamps (:data:`EPOCH_LIKE_S`), as the origin plus the exact relative times, since only
+    those keep the intervals — and relative to the first stamp.
+
+    Raises on a step that overflows or is positive but under :data:`MIN_PERIOD`, on what
+    :func:`~strapdown.io.timing.reconstruct` refuses, and when fewer than 2 distinct samples
+    remain.
+    """
+    check_stamp_steps(path, raw, scale)
+    base = relative_times(raw, scale)
+    timing = reconstruct(path, base, values, period=period, mode=timing_mode, held=held,
+                         duplicates=duplicates, jitter_tolerance=jitter_tolerance, fit=fit)
+    keep = timing.cleaning.keep
+    if keep.size < 2:
+        raise InputError(f"{path}: {keep.size} distinct samples; at least 2 are needed")
+    t_rel = base.t[keep]
+    t = base.origin + t_rel if abs(base.origin) >= EPOCH_LIKE_S else raw[keep] * scale
+    return timing, t, t_rel
 
 
 def _log_kind(path: Path, src: _Source, kind: InputKind | None) -> InputKind:

@@ -72,6 +72,7 @@ from numpy.typing import NDArray
 from strapdown._core.errors import InputError
 
 __all__ = [
+    "BRIDGE_MAX_S",
     "CLOCK_KINDS",
     "COLLISION_LIMIT",
     "DUPLICATE_POLICIES",
@@ -122,6 +123,9 @@ JITTER_TOLERANCE = 0.45
 #: tick) before the sampling counts as irregular.
 COLLISION_LIMIT = 0.01
 _ITERATIONS = 8
+#: Longest gap (s) bridged by interpolating the sensors across it (the AHRS, ``nav --on-gap
+#: report``): the error there grows with the motion the gap hides.
+BRIDGE_MAX_S = 1.0
 
 
 @dataclass(frozen=True)
@@ -378,6 +382,34 @@ class SampleClock:
         d = np.diff(self.ticks)
         return d[d > 1] - 1
 
+    def longest_gap(self) -> tuple[int, int] | None:
+        """``(sample index after it, missing ticks)`` of the longest gap; None without."""
+        lengths = self.gap_lengths()
+        if not lengths.size:
+            return None
+        i = int(np.argmax(lengths))
+        return int(self.gap_rows()[i]), int(lengths[i])
+
+    def bridge(self, *arrays: NDArray[np.float64] | None
+               ) -> tuple[NDArray[np.int64], list[NDArray[np.float64] | None]]:
+        """Every tick from the first sample's to the last's, and each ``(n, m)`` array (None
+        stays None) on them: the recorded samples as they are, the missing ones linearly
+        interpolated (without gaps, the arrays themselves)."""
+        full = np.arange(int(self.ticks[-1]) + 1)
+        if not self.missing:
+            return full, list(arrays)
+        return full, [None if x is None else np.column_stack(
+            [np.interp(full, self.ticks, x[:, j]) for j in range(x.shape[1])])
+            for x in arrays]
+
+    def resample_grid(self, t: NDArray[np.float64]) -> tuple[NDArray[np.float64], float]:
+        """``(grid, step)``: a uniform grid from ``t[0]`` to at most ``t[-1]`` to resample
+        samples taken at the stamps ``t`` onto — the clock's period, or the median interval
+        when the sampling is irregular."""
+        step = self.period if self.kind != "irregular" else float(np.median(np.diff(t)))
+        m = int(np.floor((t[-1] - t[0]) / step * (1 + 1e-12))) + 1
+        return t[0] + np.arange(m) * step, step
+
     def times(self, ticks: NDArray[np.int64] | None = None) -> NDArray[np.float64]:
         """``T(k)`` (s, relative) at ``ticks`` (default: every sample's)."""
         k = self.ticks if ticks is None else np.asarray(ticks)
@@ -628,6 +660,23 @@ class Timing:
         ``auto`` with stamps that are not irregular."""
         return self.clock is not None and (
             self.mode == "nominal" or (self.mode == "auto" and self.clock.kind != "irregular"))
+
+    def sample_period(self, t_rel: NDArray[np.float64]) -> float:
+        """The samples' period: the clock's when they lie on it, else the median interval
+        of their stamps ``t_rel``."""
+        if self.clock is not None and self.on_clock:
+            return self.clock.period
+        return float(np.median(np.diff(t_rel)))
+
+    def gap_rows(self, t_rel: NDArray[np.float64], period: float,
+                 gap_tolerance: float) -> list[int]:
+        """Data rows (1-based) that follow a gap: missing ticks on the clock when the samples
+        lie on it, else an interval of the stamps ``t_rel`` over ``gap_tolerance``
+        periods."""
+        if self.clock is not None and self.on_clock:
+            return [int(self.rows[i]) for i in self.clock.gap_rows()]
+        d = np.diff(t_rel)
+        return [int(self.rows[i + 1]) for i in np.flatnonzero(d > gap_tolerance * period)]
 
     def describe(self) -> str:
         """One line: the clock and what was done to the rows."""
