@@ -10,7 +10,8 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pytest
 
-from strapdown.io.report import Curve, log_ylim, plot_error_curves, running_envelope
+from strapdown.apps._figures import plot_curves
+from strapdown.io.report import Curve, log_ylim, running_envelope
 
 
 def _sawtooth(n=300, period=3):
@@ -48,7 +49,7 @@ def test_drawing_order_and_legend():
     t, saw = _sawtooth()
     smooth = 3e-10 * (1 + t)  # inside the sawtooth's band: must be drawn on top of it
     fig, ax = plt.subplots()
-    plot_error_curves(ax, [Curve(t, saw, "sliding", 3), Curve(t, smooth, "rate-three"),
+    plot_curves(ax, [Curve(t, saw, "sliding", 3), Curve(t, smooth, "rate-three"),
                            Curve(t, smooth, "rk4", hidden="the reference"),
                            Curve(t, np.zeros_like(t), "zero")], ylabel="difference (rad)")
     texts = [x.get_text() for x in ax.get_legend().get_texts()]
@@ -67,7 +68,7 @@ def test_wider_band_below_narrower():
     t, saw = _sawtooth()
     narrow = saw ** 0.5 * 1e-5  # the same sawtooth, half as many decades wide
     fig, ax = plt.subplots()
-    plot_error_curves(ax, [Curve(t, narrow, "narrow", 3), Curve(t, saw, "wide", 3)],
+    plot_curves(ax, [Curve(t, narrow, "narrow", 3), Curve(t, saw, "wide", 3)],
                       ylabel="e")
     fills = ax.collections
     assert len(fills) == 2

@@ -1,12 +1,13 @@
 """Shared output for reproduction reports: tables as CSV + Markdown, figures as PNG, and
-the drawing of error histories that sawtooth (:func:`plot_error_curves`)."""
+what drawing error histories needs (:class:`Curve`, :func:`running_envelope`,
+:func:`log_ylim`; the drawing itself is ``plot_curves`` in ``strapdown.apps._figures``)."""
 
 from __future__ import annotations
 
 import os
 import time
 import warnings
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -176,57 +177,3 @@ class Curve:
     label: str
     period: int = 1
     hidden: str = ""
-
-
-_MARKERS = ("o", "s", "^", "D", "v", "P", "X", "*")
-
-
-def plot_error_curves(ax: Any, curves: Sequence[Curve], *, ylabel: str) -> None:
-    """Draw error histories on a log axis so that every curve stays visible.
-
-    A sawtooth curve (``period`` > 1: interleaved chains) is drawn as a band between
-    its running minimum and maximum over one period (:func:`running_envelope`) with its
-    maximum as a line; a smooth curve as a line with a few markers (offset per curve, so
-    curves on top of each other stay distinguishable). Bands go below lines, wider
-    bands below narrower ones; the y-limits come from :func:`log_ylim` over the drawn
-    curves. Hidden curves and curves that are identically zero get a legend entry saying
-    so. The legend, below the axes, says what each entry is.
-    """
-    bands, lines, drawn, handles = [], [], [], []
-    for i, c in enumerate(curves):
-        y = np.where(np.asarray(c.y) > 0, c.y, np.nan)
-        if c.hidden or not np.any(np.isfinite(y)):
-            handles.append((i, ax.plot([], [], ls="none", color="0.4")[0],
-                            f"{c.label} ({c.hidden or 'identically zero'}, not drawn)"))
-            continue
-        drawn.append(c.y)
-        if c.period > 1:
-            lo, hi = running_envelope(y, c.period)
-            width = float(np.nanmedian(np.log10(hi) - np.log10(lo)))
-            bands.append((width, i, c, lo, hi))
-        else:
-            lines.append((i, c, y))
-    color = {i: f"C{i % 10}" for i in range(len(curves))}
-    bands.sort(key=lambda b: -b[0])  # widest first, at the bottom
-    for z, (_, i, c, lo, hi) in enumerate(bands):
-        band = ax.fill_between(c.t, lo, hi, color=color[i], alpha=0.22, lw=0, zorder=1 + z)
-        (line,) = ax.plot(c.t, hi, color=color[i], lw=0.9, zorder=1 + z)
-        handles.append((i, (band, line), f"{c.label}: range over {c.period} outputs (band) "
-                        f"and its max (line), a sawtooth of period {c.period} (interleaved "
-                        "chains)"))
-    for k, (i, c, y) in enumerate(lines):
-        every = max(1, y.size // 12)
-        (line,) = ax.plot(c.t, y, color=color[i], lw=1.2, marker=_MARKERS[k % len(_MARKERS)],
-                          ms=4, markevery=(k * every // max(1, len(lines)), every),
-                          zorder=10 + k)
-        handles.append((i, line, c.label))
-    ax.set_yscale("log")
-    lim = log_ylim(drawn)
-    if lim is not None:
-        ax.set_ylim(*lim)
-    ax.set_xlabel("t (s)")
-    ax.set_ylabel(ylabel)
-    ax.grid(True, which="both", alpha=0.3)
-    handles.sort(key=lambda h: h[0])  # the legend in the curves' order
-    ax.legend([h[1] for h in handles], [h[2] for h in handles], fontsize=7,
-              loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=1, frameon=False)
