@@ -73,6 +73,7 @@ from strapdown.algorithms.rate import JITTER_TOLERANCE as STAMP_TOLERANCE
 from strapdown.algorithms.velocity import NavStructure
 from strapdown.io import read_imu
 from strapdown.io.containers import read_hdf5, read_mat, read_npz
+from strapdown.io.files import write_csv_rows
 from strapdown.io.readers import (
     ACC_COLUMNS,
     GYRO_COLUMNS,
@@ -572,7 +573,7 @@ def _stream_to(out: Path, stream: NavStream, g: NDArray[np.float64], a: NDArray[
                  file=sys.stderr) as bar:
         if csv_out:
             f.write(",".join(NAV_COLUMNS) + "\n")
-            np.savetxt(f, first, delimiter=",", fmt="%.17g")
+            write_csv_rows(f, first)
         else:
             parts.append(first)
         for s in range(0, g.shape[0], CHUNK):
@@ -585,7 +586,7 @@ def _stream_to(out: Path, stream: NavStream, g: NDArray[np.float64], a: NDArray[
                                  f"{rows[i, 0]:.6g} s; nothing written")
             n_out += rows.shape[0]
             if csv_out:
-                np.savetxt(f, rows, delimiter=",", fmt="%.17g")
+                write_csv_rows(f, rows)
             else:
                 parts.append(rows)
         if n_out == 0:

@@ -54,6 +54,7 @@ from strapdown.algorithms.streaming import RateStream, RotvecStream
 from strapdown.algorithms.structures import increment_structure
 from strapdown.apps._logs import check_finite, output_with_sidecar, rate_records, unit_action
 from strapdown.io import read_imu
+from strapdown.io.files import write_csv_rows
 from strapdown.io.readers import (
     EPOCH_LIKE_S,
     MAX_PERIOD,
@@ -448,10 +449,6 @@ def _run_rates_streamed(imu: Path, tmp: Path, scan: _RateScan, spec: AlgorithmSp
             "time_base": timing["summary"], "motion": scan.motion.to_dict(), "streamed": True}
 
 
-#: Rows formatted at once when writing CSV (a few hundred kB of text: no memory to speak of).
-_TEXT_BLOCK = 2048
-
-
 class _Output:
     """The attitude table written as it comes: CSV rows appended (``%.17g``, as
     :func:`strapdown.io.write_attitude`), ``.npz`` columns gathered and written at the end."""
@@ -470,11 +467,8 @@ class _Output:
 
     def write(self, rows: NDArray[np.float64]) -> None:
         self.rows += rows.shape[0]
-        if self.csv:  # savetxt's text, on Python floats (15 % faster), in small blocks
-            fmt = ",".join(["%.17g"] * rows.shape[1])
-            for s in range(0, rows.shape[0], _TEXT_BLOCK):
-                self._f.write("".join([fmt % tuple(r) + "\n"
-                                       for r in rows[s:s + _TEXT_BLOCK].tolist()]))
+        if self.csv:
+            write_csv_rows(self._f, rows)
         else:
             self._parts.append(rows)
 

@@ -128,6 +128,21 @@ def remove_stale_temps(directory: str | os.PathLike, *, again: bool = False) -> 
     return removed
 
 
+#: Rows formatted at once by :func:`write_csv_rows` (a few hundred kB of text).
+CSV_BLOCK = 2048
+
+
+def write_csv_rows(f, rows) -> None:
+    """Append ``rows`` (an ``(n, m)`` float array) to the text file ``f`` as CSV, each value
+    ``%.17g`` — the text of ``np.savetxt(f, rows, delimiter=",", fmt="%.17g")``, formatted
+    on Python floats (about 15 % faster) :data:`CSV_BLOCK` rows at a time (a whole chunk's
+    strings at once cost tens of MB of peak memory)."""
+    fmt = ",".join(["%.17g"] * rows.shape[1])
+    for start in range(0, rows.shape[0], CSV_BLOCK):
+        f.write("".join([fmt % tuple(r) + "\n"
+                         for r in rows[start:start + CSV_BLOCK].tolist()]))
+
+
 def write_text(path: str | os.PathLike, text: str) -> Path:
     """Write ``text`` to ``path`` atomically (UTF-8)."""
     with atomic_path(path) as tmp:
