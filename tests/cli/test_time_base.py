@@ -137,3 +137,18 @@ def test_every_command_help_points_to_the_conventions_page(capsys):
         with pytest.raises(SystemExit):
             main([name, "--help"])
         assert "docs/conventions.md" in capsys.readouterr().out, name
+
+
+def test_ahrs_refuses_too_few_samples_naming_the_file(tmp_path):
+    """Three rows (found by the fuzz campaign): the filter's own check, an InputError that
+    names the recording, on the bridged route as on the segment route."""
+    from strapdown import InputError
+    from strapdown.apps.ahrs_log import run_ahrs
+
+    path = tmp_path / "three.csv"
+    path.write_text("t,gx,gy,gz,ax,ay,az,mx,my,mz\n0,0,0,0,0,0,9.8,20,0,-40\n"
+                    "0.01,0,0,0,0,0,9.8,20,1,-40\n0.02,0,0,0.01,0,0,9.8,20,0,-40\n")
+    for on_gap in ("report", "split"):
+        with pytest.raises(InputError, match=r"three\.csv.*3 samples.* at least 4"):
+            run_ahrs(path, tmp_path / "o.csv", gyro_units="rad/s", on_gap=on_gap)
+    assert not (tmp_path / "o.csv").exists()

@@ -374,6 +374,18 @@ def _select(res: AhrsResult, rows: np.ndarray, t: np.ndarray) -> AhrsResult:
     return dataclasses.replace(res, **cut)
 
 
+def _run_filter(imu: Path, offline: bool, *args: Any, **kwargs: Any) -> AhrsResult:
+    """:func:`~strapdown.ahrs.ekf` (``offline``: :func:`~strapdown.ahrs.offline_ekf`); the
+    filter's own input checks (too few samples, an accelerometer that is not specific
+    force …) are refusals of this recording, an :class:`~strapdown.InputError` naming it."""
+    try:
+        return (offline_ekf if offline else ekf)(*args, **kwargs)
+    except InputError:
+        raise
+    except ValueError as exc:
+        raise InputError(f"{imu}: {exc}") from None
+
+
 def _bridge(imu: Path, log: AhrsLog, algorithm: str, frame: str,
             config: AhrsConfig | None, offline: bool) -> AhrsResult:
     """The filter over the fitted clock's full grid, missing samples interpolated, its
@@ -398,8 +410,8 @@ def _bridge(imu: Path, log: AhrsLog, algorithm: str, frame: str,
         assert gyro_b is not None and acc_b is not None
         gyro, acc = gyro_b, acc_b
         t_grid = origin + clock.uniform_times(full)
-    r = (offline_ekf if offline else ekf)(t_grid, gyro, acc, mag, algorithm=algorithm,
-                                          config=config, frame=frame)
+    r = _run_filter(imu, offline, t_grid, gyro, acc, mag, algorithm=algorithm, config=config,
+                    frame=frame)
     _check_output(r, log.gyro_units)
     if uniform:
         return r
@@ -436,8 +448,8 @@ def _filter(imu: Path, log: AhrsLog, algorithm: str, frame: str, config: AhrsCon
         if rec.stamps is not None and rec.resampled:
             acc = resample_uniform(rec.stamps, acc, rec.t)
             mag = None if mag is None else resample_uniform(rec.stamps, mag, rec.t)
-        r = (offline_ekf if offline else ekf)(rec.t, rec.omega, acc, mag, algorithm=algorithm,
-                                              config=config, frame=frame, q0=q0, gyro_bias0=b0)
+        r = _run_filter(imu, offline, rec.t, rec.omega, acc, mag, algorithm=algorithm,
+                        config=config, frame=frame, q0=q0, gyro_bias0=b0)
         _check_output(r, log.gyro_units)
         parts.append(r)
         seg.append(np.full(r.t.size, float(k)))
