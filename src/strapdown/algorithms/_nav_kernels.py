@@ -240,7 +240,7 @@ def earth_nav_kernel(phi, dvb, period, lat0, lon0, h0, v0, q0, pos_out, v_out, q
 def earth_nav_chunk_kernel(phi, dvb, period, hist, nh, pos_out, v_out, q_out):
     """:func:`earth_nav_kernel` continuing a run: rows 0 of the outputs hold the state the
     chunk starts from (filled by the caller); ``hist`` (3, 12) the Earth rates
-    (:func:`_rates`, columns 0–8) and the navigation-frame specific-force increment
+    (:func:`_rates`, columns 0–8) and the body-frame velocity increment ``Δv_b``
     (columns 9–11) at the last ``nh`` updates, newest first, updated in place (``nh = 0``:
     a run's start). Returns the new ``nh``."""
     zeta = np.empty(3)
@@ -251,7 +251,10 @@ def earth_nav_chunk_kernel(phi, dvb, period, hist, nh, pos_out, v_out, q_out):
     t3 = np.empty(3)
     t4 = np.empty(3)
     t5 = np.empty(3)
+    t6 = np.empty(3)
+    db = np.empty(3)
     dx = np.empty(3)
+    dz = np.empty(3)
     pred = np.empty(9)
     end = np.empty(9)
     pp = np.empty(3)
@@ -265,7 +268,7 @@ def earth_nav_chunk_kernel(phi, dvb, period, hist, nh, pos_out, v_out, q_out):
         k = nh + 1  # points of the quadrature: this update's end and nh before
         for c in range(9):
             pred[c] = _extrap(k, hist[0, c], hist[1, c], hist[2, c])
-        # navigation-frame rotation over the update, ζ = ∫ ω_in dt
+        # navigation-frame rotation over the update, ζ = ∫ ω_in dt, predicted
         for c in range(3):
             zeta[c] = period * _am(k, pred[c], hist[0, c], hist[1, c], hist[2, c])
         # specific-force increment: body part rotated to n(m−1), then the frame rotation
@@ -276,12 +279,18 @@ def earth_nav_chunk_kernel(phi, dvb, period, hist, nh, pos_out, v_out, q_out):
         _cross(an, x, t2)  # α × X
         _cross(zeta, t2, t3)  # ζ × (α × X)
         _cross(zeta, t1, t4)  # ζ × (ζ × X)
+        # the specific force's change in the body, C (Δv_b,m − Δv_b,m−1) (the body's
+        # rotation is in α × X), and the frame rotation's, Δζ = T (ω_in,m − ω_in,m−1)
         for c in range(3):
-            dx[c] = x[c] - hist[0, 9 + c] if nh > 1 else 0.0
-        _cross(zeta, dx, t5)  # ζ × (X_m − X_{m−1}): the specific force's change
+            db[c] = dvb[m, c] - hist[0, 9 + c] if nh > 1 else 0.0
+            dz[c] = period * (pred[c] - hist[0, c])
+        _rotate(q, db, dx)
+        _cross(zeta, dx, t5)  # ζ × ΔX
+        _cross(dz, x, t6)  # Δζ × X
         vn = v_out[m + 1]
         for c in range(3):
-            vn[c] = (v[c] + (x[c] - 0.5 * t1[c] - t3[c] / 12.0 + t4[c] / 6.0 - t5[c] / 12.0)
+            vn[c] = (v[c] + (x[c] - 0.5 * t1[c] - t3[c] / 12.0 + t4[c] / 6.0
+                             - (t5[c] - t6[c]) / 12.0)
                      + period * _am(k, pred[3 + c], hist[0, 3 + c], hist[1, 3 + c],
                                     hist[2, 3 + c]))
         # predicted position, the rates at the update's end, then the correction
@@ -296,10 +305,16 @@ def earth_nav_chunk_kernel(phi, dvb, period, hist, nh, pos_out, v_out, q_out):
         for c in range(3):
             pn[c] = p[c] + period * _am(k, end[6 + c], hist[0, 6 + c], hist[1, 6 + c],
                                         hist[2, 6 + c])
+        # ζ again from the corrected end rates, with the frame's own coning
+        # (T²/12) ω_in,m−1 × ω_in,m, for the attitude
+        _cross(hist[0, :3], end[:3], dz)
+        for c in range(3):
+            zeta[c] = period * (_am(k, end[c], hist[0, c], hist[1, c], hist[2, c])
+                                + period / 12.0 * dz[c])
         hist[2, :] = hist[1, :]
         hist[1, :] = hist[0, :]
         hist[0, :9] = end
-        hist[0, 9:] = x
+        hist[0, 9:] = dvb[m]
         nh = min(nh + 1, 3)
         # attitude: q_m = q(ζ)* ⊗ q_{m−1} ⊗ q(φ)
         _update(q, phi[m], qb)

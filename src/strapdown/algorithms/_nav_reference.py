@@ -166,9 +166,10 @@ def earth_nav(body, period, pos0, v0, q0, m: Backend):
         t1 = cross(zeta, x)
         t3 = cross(zeta, cross(an, x))
         t4 = cross(zeta, t1)
-        dx = tuple(x[c] - h3[0][9 + c] if len(hist) > 1 else 0 * period for c in range(3))
-        t5 = cross(zeta, dx)
-        vp = [v[c] + (x[c] - 0.5 * t1[c] - t3[c] / 12 + t4[c] / 6 - t5[c] / 12)
+        db = tuple(dvb[c] - h3[0][9 + c] if len(hist) > 1 else 0 * period for c in range(3))
+        t5 = cross(zeta, rotate(q, db))
+        t6 = cross(tuple(period * (pred[c] - h3[0][c]) for c in range(3)), x)
+        vp = [v[c] + (x[c] - 0.5 * t1[c] - t3[c] / 12 + t4[c] / 6 - (t5[c] - t6[c]) / 12)
               + period * _am(k, pred[3 + c], *col[3 + c]) for c in range(3)]
         pp = [p[c] + period * _am(k, pred[6 + c], *col[6 + c]) for c in range(3)]
         end = earth_rates(pp[0], pp[2], vp, m)
@@ -176,6 +177,8 @@ def earth_nav(body, period, pos0, v0, q0, m: Backend):
         vn = tuple(vp[c] + period * w * (end[3 + c] - pred[3 + c]) for c in range(3))
         ps.append(tuple(p[c] + period * _am(k, end[6 + c], *col[6 + c]) for c in range(3)))
         vs.append(vn)
-        hist = [tuple(end) + tuple(x), *hist[:2]]
+        cz = cross(h3[0][:3], end[:3])
+        zeta = tuple(period * (_am(k, end[c], *col[c]) + period / 12 * cz[c]) for c in range(3))
+        hist = [tuple(end) + tuple(dvb), *hist[:2]]
         qs.append(left_update(tuple(-z for z in zeta), update(q, phi, m), m))
     return ps, vs, qs

@@ -170,8 +170,8 @@ static void sd_nav_step(NAME_state *s, const NAME_real phi[3], const NAME_real d
 {
     const NAME_real T = s->period;
     NAME_real (*H)[12] = s->hist;
-    NAME_real zeta[3], x[3], an[3], t1[3], t2[3], t3[3], t4[3], t5[3], dx[3], pred[9], end[9];
-    NAME_real pp[3], vn[3], pn[3], qb[4], w;
+    NAME_real zeta[3], x[3], an[3], t1[3], t2[3], t3[3], t4[3], t5[3], t6[3], db[3], dx[3];
+    NAME_real dz[3], pred[9], end[9], pp[3], vn[3], pn[3], qb[4], w;
     int c, k;
     if (s->nh == 0) {
         sd_rates(s->pos[0], s->pos[2], s->v, H[0]);
@@ -179,7 +179,7 @@ static void sd_nav_step(NAME_state *s, const NAME_real phi[3], const NAME_real d
     }
     k = s->nh + 1;
     for (c = 0; c < 9; ++c) pred[c] = sd_extrap(k, H[0][c], H[1][c], H[2][c]);
-    /* navigation-frame rotation over the update, zeta = integral of w_in */
+    /* navigation-frame rotation over the update, zeta = integral of w_in, predicted */
     for (c = 0; c < 3; ++c) zeta[c] = T * sd_am(k, pred[c], H[0][c], H[1][c], H[2][c]);
     /* specific-force increment: body part rotated to n(m-1), then the frame rotation */
     sd_rotate(s->q, dvb, x);
@@ -188,10 +188,18 @@ static void sd_nav_step(NAME_state *s, const NAME_real phi[3], const NAME_real d
     sd_cross(an, x, t2);
     sd_cross(zeta, t2, t3);
     sd_cross(zeta, t1, t4);
-    for (c = 0; c < 3; ++c) dx[c] = s->nh > 1 ? x[c] - H[0][9 + c] : 0.0;
+    /* the specific force's change in the body, C (dv_b,m - dv_b,m-1), and the frame
+       rotation's, dzeta = T (w_in,m - w_in,m-1) */
+    for (c = 0; c < 3; ++c) {
+        db[c] = s->nh > 1 ? dvb[c] - H[0][9 + c] : 0.0;
+        dz[c] = T * (pred[c] - H[0][c]);
+    }
+    sd_rotate(s->q, db, dx);
     sd_cross(zeta, dx, t5);
+    sd_cross(dz, x, t6);
     for (c = 0; c < 3; ++c)
-        vn[c] = (s->v[c] + (x[c] - 0.5 * t1[c] - t3[c] / 12.0 + t4[c] / 6.0 - t5[c] / 12.0))
+        vn[c] = (s->v[c] + (x[c] - 0.5 * t1[c] - t3[c] / 12.0 + t4[c] / 6.0
+                            - (t5[c] - t6[c]) / 12.0))
                 + T * sd_am(k, pred[3 + c], H[0][3 + c], H[1][3 + c], H[2][3 + c]);
     /* predicted position, the rates at the update's end, then the correction */
     for (c = 0; c < 3; ++c)
@@ -201,9 +209,14 @@ static void sd_nav_step(NAME_state *s, const NAME_real phi[3], const NAME_real d
     for (c = 0; c < 3; ++c) vn[c] += T * w * (end[3 + c] - pred[3 + c]);
     for (c = 0; c < 3; ++c)
         pn[c] = s->pos[c] + T * sd_am(k, end[6 + c], H[0][6 + c], H[1][6 + c], H[2][6 + c]);
+    /* zeta again from the corrected end rates, with the frame's own coning
+       (T^2/12) w_in,m-1 x w_in,m, for the attitude */
+    sd_cross(H[0], end, dz);
+    for (c = 0; c < 3; ++c)
+        zeta[c] = T * (sd_am(k, end[c], H[0][c], H[1][c], H[2][c]) + T / 12.0 * dz[c]);
     for (c = 0; c < 12; ++c) { H[2][c] = H[1][c]; H[1][c] = H[0][c]; }
     for (c = 0; c < 9; ++c) H[0][c] = end[c];
-    for (c = 0; c < 3; ++c) H[0][9 + c] = x[c];
+    for (c = 0; c < 3; ++c) H[0][9 + c] = dvb[c];
     s->nh = s->nh < 3 ? s->nh + 1 : 3;
     /* attitude: q_m = q(zeta)* (x) q_{m-1} (x) q(phi) */
     sd_update(s->q, phi, qb);
@@ -319,19 +332,20 @@ int NAME_update(NAME_state *s, const NAME_real dth[3], const NAME_real dv[3], NA
 #: coefficient (9 mul, 6 add); the rotation compensation (15 mul, 12 add, 3 div); the
 #: navigation step without its quaternion updates, in the steady state (four-point rules;
 #: the start-up's two- and three-point updates and the rates of the initial state cost
-#: less): extrapolation of the nine rates (18 mul, 18 add), ζ by Adams–Moulton (12 mul,
-#: 9 add, 3 div), the two rotations to n (36 mul, 24 add), five cross products (30 mul,
-#: 15 add), the specific-force change (3 add), velocity (15 mul, 27 add, 12 div),
-#: predicted position (12 mul, 12 add, 3 div), the Earth rates at the update's end: radii,
-#: gravity, ω_in, Coriolis, position rates (21 mul, 15 add, 10 div, sqrt, sin, cos; the
-#: compiler folds the constant sub-expressions), the velocity correction (6 mul, 6 add),
-#: position (12 mul, 12 add, 3 div). The body update on its sin/cos branch (as
-#: :mod:`strapdown.codegen.export_c` counts it) and the navigation-frame rotation on its
-#: series branch, |ζ|/2 < 1e-2, which it takes for any update period below ~270 s (7 mul,
-#: 7 add, 7 div instead of sin, cos and a division).
+#: less): extrapolation of the nine rates (18 mul, 18 add), the predicted ζ by
+#: Adams–Moulton (12 mul, 9 add, 3 div), three rotations to n (54 mul, 36 add), seven
+#: cross products (42 mul, 21 add), the changes of the body's velocity increment and of
+#: ω_in (3 mul, 6 add), velocity (15 mul, 30 add, 12 div), predicted position (12 mul,
+#: 12 add, 3 div), the Earth rates at the update's end: radii, gravity, ω_in, Coriolis,
+#: position rates (21 mul, 15 add, 10 div, sqrt, sin, cos; the compiler folds the constant
+#: sub-expressions), the velocity correction (6 mul, 6 add), position (12 mul, 12 add,
+#: 3 div), ζ from the end rates with the frame's coning (15 mul, 12 add, 6 div). The body
+#: update on its sin/cos branch (as :mod:`strapdown.codegen.export_c` counts it) and the
+#: navigation-frame rotation on its series branch, |ζ|/2 < 1e-2, which it takes for any
+#: update period below ~270 s (7 mul, 7 add, 7 div instead of sin, cos and a division).
 _CROSS = {"mul": 9, "add": 6}
 _ROTATION_COMP = {"mul": 15, "add": 12, "div": 3}
-_STEP = {"mul": 162, "add": 141, "div": 31, "sqrt": 1, "sin": 1, "cos": 1}
+_STEP = {"mul": 210, "add": 177, "div": 37, "sqrt": 1, "sin": 1, "cos": 1}
 _UPDATE = {"mul": 31 + 38, "add": 17 + 24, "div": 2 + 8, "sqrt": 2 + 2, "sin": 1, "cos": 1}
 
 

@@ -154,8 +154,8 @@ static void sd_nav_step(sd_nav_conventional_n3_state *s, const real_t phi[3], co
 {
     const real_t T = s->period;
     real_t (*H)[12] = s->hist;
-    real_t zeta[3], x[3], an[3], t1[3], t2[3], t3[3], t4[3], t5[3], dx[3], pred[9], end[9];
-    real_t pp[3], vn[3], pn[3], qb[4], w;
+    real_t zeta[3], x[3], an[3], t1[3], t2[3], t3[3], t4[3], t5[3], t6[3], db[3], dx[3];
+    real_t dz[3], pred[9], end[9], pp[3], vn[3], pn[3], qb[4], w;
     int c, k;
     if (s->nh == 0) {
         sd_rates(s->pos[0], s->pos[2], s->v, H[0]);
@@ -163,7 +163,7 @@ static void sd_nav_step(sd_nav_conventional_n3_state *s, const real_t phi[3], co
     }
     k = s->nh + 1;
     for (c = 0; c < 9; ++c) pred[c] = sd_extrap(k, H[0][c], H[1][c], H[2][c]);
-    /* navigation-frame rotation over the update, zeta = integral of w_in */
+    /* navigation-frame rotation over the update, zeta = integral of w_in, predicted */
     for (c = 0; c < 3; ++c) zeta[c] = T * sd_am(k, pred[c], H[0][c], H[1][c], H[2][c]);
     /* specific-force increment: body part rotated to n(m-1), then the frame rotation */
     sd_rotate(s->q, dvb, x);
@@ -172,10 +172,18 @@ static void sd_nav_step(sd_nav_conventional_n3_state *s, const real_t phi[3], co
     sd_cross(an, x, t2);
     sd_cross(zeta, t2, t3);
     sd_cross(zeta, t1, t4);
-    for (c = 0; c < 3; ++c) dx[c] = s->nh > 1 ? x[c] - H[0][9 + c] : 0.0;
+    /* the specific force's change in the body, C (dv_b,m - dv_b,m-1), and the frame
+       rotation's, dzeta = T (w_in,m - w_in,m-1) */
+    for (c = 0; c < 3; ++c) {
+        db[c] = s->nh > 1 ? dvb[c] - H[0][9 + c] : 0.0;
+        dz[c] = T * (pred[c] - H[0][c]);
+    }
+    sd_rotate(s->q, db, dx);
     sd_cross(zeta, dx, t5);
+    sd_cross(dz, x, t6);
     for (c = 0; c < 3; ++c)
-        vn[c] = (s->v[c] + (x[c] - 0.5 * t1[c] - t3[c] / 12.0 + t4[c] / 6.0 - t5[c] / 12.0))
+        vn[c] = (s->v[c] + (x[c] - 0.5 * t1[c] - t3[c] / 12.0 + t4[c] / 6.0
+                            - (t5[c] - t6[c]) / 12.0))
                 + T * sd_am(k, pred[3 + c], H[0][3 + c], H[1][3 + c], H[2][3 + c]);
     /* predicted position, the rates at the update's end, then the correction */
     for (c = 0; c < 3; ++c)
@@ -185,9 +193,14 @@ static void sd_nav_step(sd_nav_conventional_n3_state *s, const real_t phi[3], co
     for (c = 0; c < 3; ++c) vn[c] += T * w * (end[3 + c] - pred[3 + c]);
     for (c = 0; c < 3; ++c)
         pn[c] = s->pos[c] + T * sd_am(k, end[6 + c], H[0][6 + c], H[1][6 + c], H[2][6 + c]);
+    /* zeta again from the corrected end rates, with the frame's own coning
+       (T^2/12) w_in,m-1 x w_in,m, for the attitude */
+    sd_cross(H[0], end, dz);
+    for (c = 0; c < 3; ++c)
+        zeta[c] = T * (sd_am(k, end[c], H[0][c], H[1][c], H[2][c]) + T / 12.0 * dz[c]);
     for (c = 0; c < 12; ++c) { H[2][c] = H[1][c]; H[1][c] = H[0][c]; }
     for (c = 0; c < 9; ++c) H[0][c] = end[c];
-    for (c = 0; c < 3; ++c) H[0][9 + c] = x[c];
+    for (c = 0; c < 3; ++c) H[0][9 + c] = dvb[c];
     s->nh = s->nh < 3 ? s->nh + 1 : 3;
     /* attitude: q_m = q(zeta)* (x) q_{m-1} (x) q(phi) */
     sd_update(s->q, phi, qb);

@@ -4,7 +4,7 @@
  * position by Adams-Moulton quadrature of the Earth rates, attitude q_n_b. Savage (1998b);
  * sculling coefficients from the designer's sculling target (= the coning set, Ignagni 1998).
  * Real type: double. Input: gyro increments (rad), accelerometer increments (m/s).
- * Operations per update: mul 300, add 230, div 44, sqrt 5, sin 2, cos 2, tan 0.
+ * Operations per update: mul 348, add 266, div 50, sqrt 5, sin 2, cos 2, tan 0.
  */
 #ifndef SD_NAV_SINGLE_CHAIN_N3_H
 #define SD_NAV_SINGLE_CHAIN_N3_H
