@@ -22,11 +22,12 @@ from strapdown.algorithms.velocity import (
 from strapdown.truth.sculling import classical_sculling
 
 
-def _twin(g, a, n, h, structure):
+def _twin(g, a, n, h, structure, velocity_set="coning-force"):
     gl, al = [tuple(r) for r in g], [tuple(r) for r in a]
     if structure == "conventional":
         body = ref.conventional_body(gl, al, coefficient_set("table3", n).matrix.tolist(),
-                                     sculling_matrix(n).tolist(), h, 0.0)
+                                     sculling_matrix(n, velocity_set=velocity_set).tolist(), h,
+                                     0.0)
         period = n * h
     else:
         body = ref.single_chain_body(gl, al, single_chain_table(n).tolist(),
@@ -36,14 +37,15 @@ def _twin(g, a, n, h, structure):
     return np.array(q), np.array(v), np.array(p)
 
 
+@pytest.mark.parametrize("velocity_set", ["coning-force", "classical"])
 @pytest.mark.parametrize("structure", ["conventional", "single-chain"])
 @pytest.mark.parametrize("n", [1, 2, 3, 4, 5, 6])
-def test_kernels_match_the_plain_python_twin(n, structure):
+def test_kernels_match_the_plain_python_twin(n, structure, velocity_set):
     rng = np.random.default_rng(10 * n + len(structure))
     g = rng.normal(size=(60, 3)) * 0.03
     a = rng.normal(size=(60, 3)) * 0.2
-    sol = integrate_inertial(g, a, n, h=0.01, structure=structure)
-    q, v, p = _twin(g, a, n, 0.01, structure)
+    sol = integrate_inertial(g, a, n, h=0.01, structure=structure, velocity_set=velocity_set)
+    q, v, p = _twin(g, a, n, 0.01, structure, velocity_set)
     assert q.shape == sol.q.shape
     assert np.max(np.abs(q - sol.q)) <= 1e-15  # the exponential map's series vs sin (≤ 1 ulp)
     assert np.max(np.abs(v - sol.v)) <= 1e-15 and np.max(np.abs(p - sol.p)) <= 1e-15

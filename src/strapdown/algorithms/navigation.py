@@ -6,26 +6,38 @@ Per update of period ``T`` with body increments ``φ``, ``Δv_b`` (:func:`body_i
 and the state at ``t_{m−1}``:
 
 * the Earth rates ``r = (ω_in, γ − (ω_ie + ω_in) × v, L̇, λ̇, ḣ)`` (WGS-84 radii, normal
-  gravity by Somigliana with the height correction, :mod:`strapdown.truth.earth`) are kept
-  at the last three updates; their value at ``t_m`` is extrapolated (quadratically), and
-  every Earth term is integrated over the update by the Adams–Moulton rule of the four
-  points ``t_{m−3} … t_m``, ``T (9 r_m + 19 r_{m−1} − 5 r_{m−2} + r_{m−3})/24`` (the two-
-  and three-point rules at a run's first two updates): ``ζ = ∫ ω_in dt``;
-* specific-force increment ``X = C_{m−1} Δv_b``, ``Δv_SF = X − ½ ζ × X − (1/12) ζ × (α × X)
-  + ⅙ ζ × (ζ × X) − (1/12) ζ × (X − X_{m−1})`` (``α = C_{m−1} φ``): the navigation-frame
-  rotation to second order, consistent with the body's ``½ α × υ + ⅙ α × (α × υ)`` so that
-  a vehicle at rest on the Earth (``α = ζ``) integrates exactly, and the last term the
-  first-order change of the specific force over the update (Savage (1998b)'s velocity
-  rotation integral for a linearly varying specific force);
+  gravity by Somigliana with the second-order or the linear height correction,
+  :mod:`strapdown.truth.earth`) are kept at the last three updates; their value at ``t_m``
+  is extrapolated (quadratically), and every Earth term is integrated over the update by
+  the Adams–Moulton rule of the four points ``t_{m−3} … t_m``,
+  ``T (9 r_m + 19 r_{m−1} − 5 r_{m−2} + r_{m−3})/24`` (the two- and three-point rules at a
+  run's first two updates): the predicted ``ζ = ∫ ω_in dt``;
+* specific-force increment ``X = C_{m−1} Δv_b``, ``α = C_{m−1} φ``,
+  ``Δv_SF = X − ½ ζ × X − (1/12) ζ × (α × X) + ⅙ ζ × (ζ × X) − (1/12)(ζ × ΔX − Δζ × X)``
+  with ``ΔX = C_{m−1}(Δv_b,m − Δv_b,m−1)`` (the specific force's change in the body; its
+  rotation is the ``α × X`` term) and ``Δζ = T (ω_in,m − ω_in,m−1)``: Savage (1998b)'s
+  velocity rotation integral for a specific force and a frame rate varying linearly over
+  the update, to second order in the frame rotation, exact for a vehicle at rest on the
+  Earth (``α = ζ``); ``ΔX`` and ``Δζ`` are zero at a run's first update;
 * ``v_m = v_{m−1} + Δv_SF + ∫ [γ − (2 ω_ie + ω_en) × v] dt``, the latitude, longitude and
   height predicted with the extrapolated rates, the rates evaluated at the predicted
   ``t_m`` state, the gravity–Coriolis integral corrected with them (predictor–corrector),
   and the position integrated by the same rule with them;
-* ``q_m = q(−ζ) ⊗ q_{m−1} ⊗ q(φ)``.
+* ``ζ`` again by the same rule from those corrected rates, plus the frame's own coning
+  ``(T²/12) ω_in,m−1 × ω_in,m`` (Bortz (1971)), and ``q_m = q(−ζ) ⊗ q_{m−1} ⊗ q(φ)``.
 
-The Earth terms are thus integrated to fourth order; the navigation's order is that of
-the body increments (on a smooth manoeuvre: second for N = 1, third for N ≥ 2, see
-``strapdown reproduce sculling``).
+The Earth terms are thus integrated to fourth order, from the first update on; the
+navigation's order is that of the body increments (on a smooth manoeuvre: second for
+N = 1, third for N ≥ 2, see ``strapdown reproduce sculling``), also on a manoeuvre that
+accelerates from its first update (``tests/algorithms/test_navigation_startup.py``: the
+first update's ζ used to come from the start rates alone, a one-off ``½ T² |ω̇_in|`` tilt,
+and the velocity update counted the body's rotation twice).
+
+Conventions: each increment covers the interval that ends at its stamp, so the initial
+state is at ``t0`` = the first stamp − ``h`` (the start of the first interval); the
+solution's row 0 is that state and row ``m`` the state at ``t0 + m T``. Increments short
+of a whole conventional update at the end (fewer than N) are dropped with a
+:class:`TrailingSamplesWarning` (``trailing="drop"``) or refused (``"error"``).
 
 :class:`NavStream` runs the same update over a log fed in chunks, equal to
 :func:`navigate` bit for bit whatever the chunking.
@@ -34,16 +46,35 @@ the body increments (on a smooth manoeuvre: second for N = 1, third for N ≥ 2,
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
+from typing import Literal, get_args
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from strapdown._core.errors import InputError
 from strapdown._core.validation import as_quaternions, as_vectors, finite_array
 from strapdown.algorithms import _nav_kernels
-from strapdown.algorithms.velocity import NavStructure, body_increments
+from strapdown.algorithms.velocity import (
+    DEFAULT_VELOCITY_SET,
+    NavStructure,
+    VelocitySet,
+    body_increments,
+)
+from strapdown.truth.earth import GRAVITY_MODELS, GravityModel, gravity_quadratic
 
-__all__ = ["POLE_LIMIT_DEG", "NavSolution", "NavStream", "navigate"]
+__all__ = ["GRAVITY_MODELS", "POLE_LIMIT_DEG", "TRAILING_POLICIES", "GravityModel",
+           "NavSolution", "NavStream", "TrailingPolicy", "TrailingSamplesWarning", "navigate"]
+
+#: What :func:`navigate` does with fewer than N increments left after the last whole
+#: conventional update: navigate without them and warn (``"drop"``), or refuse (``"error"``).
+TrailingPolicy = Literal["drop", "error"]
+TRAILING_POLICIES: tuple[TrailingPolicy, ...] = get_args(TrailingPolicy)
+
+
+class TrailingSamplesWarning(UserWarning):
+    """Increments short of a whole update at the end of a record were not navigated."""
 
 #: Largest latitude magnitude (deg) navigated: the mechanisation runs in the local-level,
 #: north-pointing NED frame, whose transport rate (``v_E tan φ / R``) and longitude rate
@@ -94,8 +125,15 @@ def _initial(lat, lon, height, v0, q0):
 def navigate(gyro: ArrayLike, accel: ArrayLike, n: int, *, h: float, lat: float, lon: float,
              height: float, v0: ArrayLike | None = None, q0: ArrayLike | None = None,
              structure: NavStructure = "conventional", t0: float = 0.0,
-             sculling: bool = True) -> NavSolution:
-    """Navigate from gyro (rad) and accelerometer (m/s) increments every ``h`` seconds.
+             sculling: bool = True, velocity_set: VelocitySet = DEFAULT_VELOCITY_SET,
+             gravity: GravityModel = "wgs84", trailing: TrailingPolicy = "drop"
+             ) -> NavSolution:
+    """Navigate from gyro (rad) and accelerometer (m/s) increments every ``h`` seconds
+    (the equations and conventions: module docstring).
+
+    Increment ``i`` (row ``i`` of ``gyro`` and ``accel``, from 0) covers the interval
+    ``[t0 + i h, t0 + (i + 1) h]``: a log whose increments are stamped at the ends of their
+    intervals, ``t_1, t_2, …``, starts at ``t0 = t_1 − h``, where the initial state is.
 
     Parameters
     ----------
@@ -113,19 +151,57 @@ def navigate(gyro: ArrayLike, accel: ArrayLike, n: int, *, h: float, lat: float,
     structure : {"conventional", "single-chain"}
     sculling : bool
         False drops the sculling terms (rotation compensation only).
+    velocity_set : {"coning-force", "classical"}
+        The conventional structure's sculling pairs
+        (:func:`strapdown.algorithms.velocity.body_increments`).
+    t0 : float
+        Time of the initial state (s): the start of the first increment's interval.
+    gravity : {"wgs84", "linear"}
+        Normal gravity's height correction: the WGS-84 formula's second-order one (default)
+        or its linear term (:func:`strapdown.truth.earth.gravity`).
+    trailing : {"drop", "error"}
+        Fewer than N increments left after the last whole conventional update: navigated
+        without, with a :class:`TrailingSamplesWarning` (default, as ``strapdown nav``), or
+        an :class:`~strapdown._core.errors.InputError` naming them.
+
+    Returns
+    -------
+    NavSolution
+        Row 0 the initial state at ``t0``, row ``m`` the state at ``t0 + m T`` (``T = N h``
+        for the conventional structure, ``h`` for the single chain).
     """
     lat, lon, height, v0, q0 = _initial(lat, lon, height, v0, q0)
-    b = body_increments(gyro, accel, n, h=h, structure=structure, sculling=sculling)
+    quad = gravity_quadratic(gravity)
+    b = body_increments(gyro, accel, n, h=h, structure=structure, sculling=sculling,
+                        velocity_set=velocity_set)
     m = b.phi.shape[0]
+    _trailing(np.shape(gyro)[0] - m * round(b.update_period / h), b.n, h, trailing)
     pos = np.empty((m + 1, 3))
     v = np.empty((m + 1, 3))
     q = np.empty((m + 1, 4))
     _nav_kernels.earth_nav_kernel(b.phi, b.dv, b.update_period, lat, lon, height, v0, q0,
-                                  pos, v, q)
+                                  pos, v, q, quad)
     t = float(finite_array(t0, "t0")) + np.arange(m + 1) * b.update_period
     _check_pole(t, pos[:, 0])
     return NavSolution(t, pos[:, 0], pos[:, 1], pos[:, 2], v, q, structure, b.n,
                        b.update_period)
+
+
+def _trailing(left: int, n: int, h: float, policy: TrailingPolicy) -> None:
+    """Warn about, or refuse (``policy == "error"``), ``left`` increments short of a whole
+    update of N = ``n`` at the end of a record."""
+    if policy not in TRAILING_POLICIES:
+        raise ValueError(f"trailing must be one of {', '.join(TRAILING_POLICIES)}, got "
+                         f"{policy!r}")
+    if not left:
+        return
+    what = (f"{left} increment(s) after the last whole update of N = {n} "
+            f"({left * h:.6g} s at the end of the record)")
+    if policy == "error":
+        raise InputError(f"{what}: not a whole update (trailing='error'); trailing='drop' "
+                         "navigates without them, the single chain updates every sample")
+    warnings.warn(f"{what} not navigated (trailing='drop')", TrailingSamplesWarning,
+                  stacklevel=3)
 
 
 def _check_pole(t: NDArray[np.float64], lat: NDArray[np.float64]) -> None:
@@ -153,16 +229,21 @@ class NavStream:
     keeps the last N − 1 samples (its pair terms reach N − 1 back); the navigation state
     keeps the Earth rates of the last three updates.
 
-    Parameters are those of :func:`navigate`; ``t0`` is the time of the initial state.
+    Parameters are those of :func:`navigate` (``trailing`` aside: a stream does not know
+    where it ends; :attr:`pending` holds the samples short of an update); ``t0`` is the
+    time of the initial state.
     """
 
     def __init__(self, n: int, *, h: float, lat: float, lon: float, height: float,
                  v0: ArrayLike | None = None, q0: ArrayLike | None = None,
                  structure: NavStructure = "conventional", t0: float = 0.0,
-                 sculling: bool = True):
+                 sculling: bool = True, velocity_set: VelocitySet = DEFAULT_VELOCITY_SET,
+                 gravity: GravityModel = "wgs84"):
         from strapdown._core.validation import positive
-        from strapdown.algorithms.velocity import _n, _structure
+        from strapdown.algorithms.velocity import _n, _structure, _velocity_set
 
+        self.velocity_set = _velocity_set(velocity_set)
+        self.gravity, self._quad = gravity, gravity_quadratic(gravity)
         lat, lon, height, v, q = _initial(lat, lon, height, v0, q0)
         self.n, self.h = _n(n), positive(h, "h (sample interval)")
         self.structure, self.sculling = _structure(structure), bool(sculling)
@@ -192,12 +273,19 @@ class NavStream:
             return None
         cg, ca = self._ctx
         b = body_increments(np.concatenate([cg, g]), np.concatenate([ca, a]), n, h=self.h,
-                            structure=self.structure, sculling=self.sculling)
+                            structure=self.structure, sculling=self.sculling,
+                            velocity_set=self.velocity_set)
         skip = cg.shape[0] // (n if self.structure == "conventional" else 1)
         both_g, both_a = np.concatenate([cg, g]), np.concatenate([ca, a])
         start = max(both_g.shape[0] - keep, 0)
         self._ctx = (both_g[start:], both_a[start:]) if keep else (_Z3, _Z3)
         return b.phi[skip:], b.dv[skip:]
+
+    @property
+    def pending(self) -> int:
+        """Samples fed but short of a whole conventional update (always 0 for the single
+        chain): what :func:`navigate` would drop or refuse were the record to end here."""
+        return int(self._pending[0].shape[0])
 
     def feed(self, gyro: ArrayLike, accel: ArrayLike) -> NavSolution:
         """Advance by gyro (rad) and accelerometer (m/s) increments ``(k, 3)``; returns the
@@ -215,7 +303,7 @@ class NavStream:
             assert body is not None
             self._nh = _nav_kernels.earth_nav_chunk_kernel(
                 np.ascontiguousarray(body[0]), np.ascontiguousarray(body[1]),
-                self.update_period, self._hist, self._nh, pos, v, q)
+                self.update_period, self._hist, self._nh, pos, v, q, self._quad)
             self._pos, self._v, self._q = pos[-1].copy(), v[-1].copy(), q[-1].copy()
         t = self._t0 + (self._updates + 1 + np.arange(m)) * self.update_period
         _check_pole(t, pos[1:, 0])

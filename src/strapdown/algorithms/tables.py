@@ -16,11 +16,13 @@ from strapdown.algorithms.coning import TABLE3
 from strapdown.algorithms.family import RateCoefficients, Rk4Step
 
 __all__ = [
+    "CONING_FORCE_DRIFT",
     "RATE_SINGLE",
     "RATE_SINGLE_DRIFT",
     "RATE_THREE",
     "RATE_THREE_DRIFT",
     "RK4_DRIFT",
+    "SCULLING_CONING_FORCE",
     "SCULLING_CONVENTIONAL",
     "SCULLING_DRIFT",
     "SCULLING_SINGLE_CHAIN",
@@ -86,4 +88,42 @@ SCULLING_DRIFT: dict[int, tuple[int, F]] = {
     4: (8, F(1, 1260)),
     5: (10, F(1, 5544)),
     6: (12, F(1, 24024)),
+}
+
+
+#: Velocity pairs of the conventional structure that hold on a coning body in a constant
+#: specific force as well as under classical sculling: ``Σ_{i<j} k_ij (θ_i × v_j + v_i ×
+#: θ_j)`` over *all* pairs of the N subsamples, in the order (0, 1), (0, 2), …, (0, N−1),
+#: (1, 2), …, (N−2, N−1) (0-based), from ``derive(interval_structure(N, "all-pairs"),
+#: target="coning-force", rule="min-norm")``. Their lag sums are the classical set's
+#: (:data:`SCULLING_CONVENTIONAL`), so the classical-sculling law is unchanged; N = 1, 2 are the
+#: classical sets.
+SCULLING_CONING_FORCE: dict[int, tuple[F, ...]] = {
+    1: (),
+    2: (F(2, 3),),
+    3: (F(31, 20), F(9, 20), F(-1, 5)),
+    4: (F(236, 105), F(26, 21), F(18, 35), F(-6, 7), F(-38, 105), F(68, 105)),
+    5: (F(165, 56), F(1405, 1008), F(205, 112), F(125, 252), F(-1265, 1008), F(-425, 504),
+        F(-265, 336), F(715, 1008), F(745, 1008), F(55, 168)),
+    6: (F(5589, 1540), F(29597, 18480), F(41159, 18480), F(449, 220), F(463, 924),
+        F(-599, 336), F(-16789, 18480), F(-13697, 9240), F(-4871, 4620), F(3447, 3080),
+        F(14671, 18480), F(15419, 18480), F(-9, 112), F(551, 2640), F(2467, 4620)),
+}
+
+#: Coning-in-constant-force law, (order, c) per N, with the rectified velocity error rate
+#: along the cone axis ``−c · a² f (Ωh)^order`` (half angle ``a``, cone rate ``Ω``, force
+#: ``f`` along the cone axis; leading order in ``a``), from
+#: :func:`strapdown.design.velocity_error_laws`, per (structure, velocity set). The classical
+#: sets stop at order 4 for every N ≥ 2: their pair coefficients are all fixed by the
+#: sculling conditions.
+CONING_FORCE_DRIFT: dict[tuple[str, str], dict[int, tuple[int, F]]] = {
+    ("conventional", "coning-force"): {
+        1: (2, F(1, 12)), 2: (4, F(-1, 20)), 3: (6, F(-29, 840)), 4: (8, F(-19, 1260)),
+        5: (10, F(-31, 5544)), 6: (12, F(-137, 72072))},
+    ("conventional", "classical"): {
+        1: (2, F(1, 12)), 2: (4, F(-1, 20)), 3: (4, F(-31, 40)), 4: (4, F(-59, 20)),
+        5: (4, F(-2665, 336)), 6: (4, F(-1049, 60))},
+    ("single-chain", "classical"): {
+        1: (2, F(1, 12)), 2: (4, F(1, 30)), 3: (4, F(1, 120)), 4: (4, F(11, 1680)),
+        5: (4, F(29, 5040)), 6: (4, F(7, 1320))},
 }

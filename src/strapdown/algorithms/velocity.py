@@ -9,10 +9,17 @@ rotation vector (coning)
 velocity increment (rotation + sculling compensation)
     ``Δv_b = υ + ½ α × υ + ⅙ α × (α × υ) + Σ_{i<j} s_ij (θ_i × v_j + v_i × θ_j)``;
     ``½ α × υ + ⅙ α × (α × υ)`` is the rotation compensation of a constant rate to second
-    order, the pair sum the sculling compensation ``½∫(α × f + υ × ω) dt``. The sculling
-    coefficients ``s`` come from the designer's sculling target
-    (:data:`strapdown.algorithms.tables.SCULLING_CONVENTIONAL`), which reproduces the
-    coning set of the same structure.
+    order, the pair sum the sculling compensation ``½∫(α × f + υ × ω) dt``. Two velocity
+    sets (``velocity_set``): ``"classical"``, the designer's sculling target on the pairs
+    with the last subsample (:data:`strapdown.algorithms.tables.SCULLING_CONVENTIONAL`, the
+    coning set of the same structure), and ``"coning-force"`` (the default), the designer's
+    ``coning-force`` target on all pairs ``i < j``
+    (:data:`strapdown.algorithms.tables.SCULLING_CONING_FORCE`): the same classical-sculling
+    law, and a body coning in a constant specific force (gravity) is also cancelled to
+    order 2N. The classical sets leave that coning × force term at ``(Ωh)⁴`` for every
+    N ≥ 2 with a constant that grows with N (:func:`coning_force_law`, constants
+    −1/20, −31/40, −59/20, −2665/336, −1049/60 for N = 2–6): on a coning body in gravity
+    a classical N ≥ 3 set is worse than N = 2. N = 1, 2 have one set.
 position increment (scrolling compensation)
     ``ΔR_b = h (Σ_{j=1}^{N−1} ΔV_j + ½ Δv_b)``: the trapezoid rule over the
     subsample-resolved velocity increment ``ΔV_j`` (rotation compensation on the partial
@@ -23,7 +30,11 @@ position increment (scrolling compensation)
 The single chain (``single-chain``) updates every sample with the designer's single-chain
 coefficients for both corrections, ``Δv_k = v_k + ½ θ_k × v_k + ⅙ θ_k × (θ_k × v_k) +
 Σ_m c_m (θ_{k−m} × v_k + v_{k−m} × θ_k)`` and ``ΔR_k = ½ h Δv_k`` (start-up: sample
-k < N − 1 uses the (k+1)-sample set).
+k < N − 1 uses the (k+1)-sample set). Its N − 1 coefficients are all fixed by the sculling
+conditions, so no set of this form cancels the coning × force term beyond ``(Ωh)⁴``
+(:func:`strapdown.design.derive` with ``target="coning-force"`` stops there); its
+constant is small (1/30, 1/120, 11/1680 for N = 2–4), and both velocity-set names select
+its one (classical) set.
 
 Classical-sculling law (derived by :func:`strapdown.design.derive` with
 ``target="sculling"``): the rectified velocity error rate along the axis normal to both
@@ -66,13 +77,18 @@ from strapdown.algorithms.coning import MAX_SUBSAMPLES, coefficient_set
 from strapdown.algorithms.structures import single_chain_table
 
 __all__ = [
+    "DEFAULT_VELOCITY_SET",
     "NAV_STRUCTURES",
     "RATE_VELOCITY_ALGORITHMS",
+    "VELOCITY_SETS",
     "BodyIncrements",
+    "ConingForceLaw",
     "InertialSolution",
     "NavStructure",
     "ScullingLaw",
+    "VelocitySet",
     "body_increments",
+    "coning_force_law",
     "integrate_inertial",
     "integrate_inertial_mp",
     "integrate_inertial_rates",
@@ -85,6 +101,11 @@ __all__ = [
 #: Update structures of the velocity/position algorithms.
 NavStructure = Literal["conventional", "single-chain"]
 NAV_STRUCTURES: tuple[NavStructure, ...] = get_args(NavStructure)
+#: The velocity (sculling) sets of the conventional structure (module docstring).
+VelocitySet = Literal["coning-force", "classical"]
+VELOCITY_SETS: tuple[VelocitySet, ...] = get_args(VelocitySet)
+#: What ``body_increments``, ``integrate_inertial`` and the navigation run by default.
+DEFAULT_VELOCITY_SET: VelocitySet = "coning-force"
 
 
 @dataclass(frozen=True)
@@ -115,20 +136,58 @@ def _structure(structure: object) -> NavStructure:
     return structure
 
 
+def _velocity_set(name: object) -> VelocitySet:
+    if name not in VELOCITY_SETS:
+        raise ValueError(f"unknown velocity set {name!r}; choose one of "
+                         f"{', '.join(VELOCITY_SETS)}")
+    return name
+
+
+@dataclass(frozen=True)
+class ConingForceLaw:
+    """Rectified velocity error rate along the cone axis of a body coning (half angle ``a``,
+    cone rate ``Ω``) in a constant specific force ``f`` along that axis:
+    ``−c · a² f (Ωh)^order`` (leading order in ``a``)."""
+
+    order: int
+    constant: Fraction
+
+    def predict(self, half_angle: float, force: float, cone_rate: float, h: float) -> float:
+        """The law's rate (m/s²) along the cone axis."""
+        return -float(self.constant) * half_angle**2 * force * (cone_rate * h) ** self.order
+
+
+def coning_force_law(n: int, structure: NavStructure = "conventional",
+                     velocity_set: VelocitySet = DEFAULT_VELOCITY_SET) -> ConingForceLaw:
+    """The coning-in-constant-force law of a structure's velocity set
+    (:data:`tables.CONING_FORCE_DRIFT`; the single chain has one set)."""
+    n, structure = _n(n), _structure(structure)
+    key = (structure, "classical" if structure == "single-chain"
+           else _velocity_set(velocity_set))
+    order, c = tables.CONING_FORCE_DRIFT[key][n]
+    return ConingForceLaw(order, c)
+
+
 def sculling_law(n: int) -> ScullingLaw:
     """The classical-sculling law of the N-sample sets (:data:`tables.SCULLING_DRIFT`)."""
     order, c = tables.SCULLING_DRIFT[_n(n)]
     return ScullingLaw(order, c)
 
 
-def sculling_matrix(n: int, *, exact: bool = False):
+def sculling_matrix(n: int, *, exact: bool = False, velocity_set: VelocitySet = "classical"):
     """``(N, N)`` upper-triangular sculling matrix of the conventional structure:
-    ``s[N−1−m, N−1] = ς_m`` (cross with the last subsample). ``exact=True``: nested lists
-    of :class:`~fractions.Fraction`."""
+    ``"classical"``: ``s[N−1−m, N−1] = ς_m`` (cross with the last subsample);
+    ``"coning-force"``: ``s[i, j] = k_ij`` over all pairs. ``exact=True``: nested lists of
+    :class:`~fractions.Fraction`."""
     n = _n(n)
     rows = [[Fraction(0)] * n for _ in range(n)]
-    for m, c in enumerate(tables.SCULLING_CONVENTIONAL[n], start=1):
-        rows[n - 1 - m][n - 1] = c
+    if _velocity_set(velocity_set) == "coning-force":
+        pairs = [(i, j) for i in range(n) for j in range(i + 1, n)]
+        for (i, j), c in zip(pairs, tables.SCULLING_CONING_FORCE[n], strict=True):
+            rows[i][j] = c
+    else:
+        for m, c in enumerate(tables.SCULLING_CONVENTIONAL[n], start=1):
+            rows[n - 1 - m][n - 1] = c
     if exact:
         return rows
     return np.array([[float(v) for v in r] for r in rows])
@@ -180,8 +239,8 @@ def _inputs(gyro: ArrayLike, accel: ArrayLike) -> tuple[NDArray[np.float64], NDA
 
 
 def body_increments(gyro: ArrayLike, accel: ArrayLike, n: int, *, h: float,
-                    structure: NavStructure = "conventional", sculling: bool = True
-                    ) -> BodyIncrements:
+                    structure: NavStructure = "conventional", sculling: bool = True,
+                    velocity_set: VelocitySet = DEFAULT_VELOCITY_SET) -> BodyIncrements:
     """Coning, sculling and scrolling compensated body increments (module docstring).
 
     Parameters
@@ -196,6 +255,9 @@ def body_increments(gyro: ArrayLike, accel: ArrayLike, n: int, *, h: float,
     sculling : bool
         False drops the sculling pair terms (rotation compensation only), to show their
         effect; the coning correction stays.
+    velocity_set : {"coning-force", "classical"}
+        The conventional structure's sculling pairs (module docstring); the single chain
+        has one set.
 
     Notes
     -----
@@ -203,12 +265,13 @@ def body_increments(gyro: ArrayLike, accel: ArrayLike, n: int, *, h: float,
     """
     g, a = _inputs(gyro, accel)
     n, h = _n(n), positive(h, "h (sample interval)")
+    velocity_set = _velocity_set(velocity_set)
     if _structure(structure) == "conventional":
         m = g.shape[0] // n
         if m < 1:
             raise ValueError(f"N = {n} needs at least {n} samples, got {g.shape[0]}")
         kc = np.ascontiguousarray(coefficient_set("table3", n).matrix)
-        ks = sculling_matrix(n) if sculling else np.zeros((n, n))
+        ks = sculling_matrix(n, velocity_set=velocity_set) if sculling else np.zeros((n, n))
         out = np.empty((3, m, 3))
         _nav_kernels.conventional_body_kernel(g[: m * n], a[: m * n], kc, ks, h, out[0],
                                               out[1], out[2])
@@ -256,7 +319,8 @@ def _state(q0, v0, p0):
 def integrate_inertial(gyro: ArrayLike, accel: ArrayLike, n: int, *, h: float,
                        structure: NavStructure = "conventional", t0: float = 0.0,
                        q0: ArrayLike | None = None, v0: ArrayLike | None = None,
-                       p0: ArrayLike | None = None, sculling: bool = True) -> InertialSolution:
+                       p0: ArrayLike | None = None, sculling: bool = True,
+                       velocity_set: VelocitySet = DEFAULT_VELOCITY_SET) -> InertialSolution:
     """Strapdown integration in a non-rotating frame without gravity (sculling studies).
 
     ``v_m = v_{m−1} + C_{m−1} Δv_b``, ``p_m = p_{m−1} + v_{m−1} T + C_{m−1} ΔR_b``,
@@ -264,7 +328,8 @@ def integrate_inertial(gyro: ArrayLike, accel: ArrayLike, n: int, *, h: float,
     """
     q0, v0, p0 = _state(q0, v0, p0)
     t0 = float(finite_array(t0, "t0"))
-    b = body_increments(gyro, accel, n, h=h, structure=structure, sculling=sculling)
+    b = body_increments(gyro, accel, n, h=h, structure=structure, sculling=sculling,
+                        velocity_set=velocity_set)
     m = b.phi.shape[0]
     q = np.empty((m + 1, 4))
     v = np.empty((m + 1, 3))
@@ -291,7 +356,9 @@ class MpInertialSolution:
 
 
 def integrate_inertial_mp(motion, n: int, *, h: float, samples: int, digits: int,
-                          structure: NavStructure = "conventional") -> MpInertialSolution:
+                          structure: NavStructure = "conventional",
+                          velocity_set: VelocitySet = DEFAULT_VELOCITY_SET
+                          ) -> MpInertialSolution:
     """:func:`integrate_inertial` in arbitrary precision on a closed-form sculling motion.
 
     Exact increments (:meth:`~strapdown.truth.sculling.ScullingMotion.increment_mp`,
@@ -314,6 +381,7 @@ def integrate_inertial_mp(motion, n: int, *, h: float, samples: int, digits: int
     if digits < 17:
         raise ValueError(f"digits must be at least 17 (float64 is ~16), got {digits}")
     _structure(structure)
+    _velocity_set(velocity_set)
     with mpmath.workdps(digits):
         hm = mpmath.mpf(h)
         edges = [k * hm for k in range(samples + 1)]
@@ -326,7 +394,8 @@ def integrate_inertial_mp(motion, n: int, *, h: float, samples: int, digits: int
 
         if structure == "conventional":
             kc = mp(coefficient_set("table3", n).exact)
-            body = ref.conventional_body(g, a, kc, mp(sculling_matrix(n, exact=True)), hm, zero)
+            body = ref.conventional_body(g, a, kc, mp(sculling_matrix(
+                n, exact=True, velocity_set=velocity_set)), hm, zero)
             period, startup = n * hm, 0
         else:
             from strapdown.algorithms.structures import single_chain_coefficients

@@ -467,7 +467,7 @@ def navigate_log(imu: str | os.PathLike[str], out: str | os.PathLike[str], *, la
                  attitude_deg: ArrayLike | None = None, kind: InputKind = "rate",
                  units: GyroUnit | None = None, acc_units: AccUnit | None = None,
                  columns: Sequence[str] | None = None, sample_rate_hz: float | None = None,
-                 subsamples: int = 2, structure: NavStructure = "conventional",
+                 subsamples: int = 3, structure: NavStructure = "conventional",
                  sculling: bool = True,
                  accept_unit_warning: bool = False, progress: bool = False,
                  on_gap: NavGapPolicy = "error", timing: TimingMode = "auto",

@@ -89,8 +89,9 @@ def _arguments(p: argparse.ArgumentParser) -> None:
     a = p.add_argument_group("algorithm")
     a.add_argument("--structure", choices=NAV_STRUCTURES, default="conventional",
                    help="conventional: an update every N samples; single-chain: every sample")
-    a.add_argument("--subsamples", type=int, default=2,
-                   help="N of the coning and sculling corrections (1-6)")
+    a.add_argument("--subsamples", type=int, default=3,
+                   help="N of the coning and sculling corrections (1-6; default 3, whose "
+                   "velocity set also holds on a coning body in gravity)")
     a.add_argument("--no-sculling", dest="sculling", action="store_false",
                    help="drop the sculling correction (rotation compensation only)")
     a.add_argument("--trailing", choices=TRAILING_POLICIES, default="drop",

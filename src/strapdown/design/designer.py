@@ -25,6 +25,17 @@ Targets
     (Ignagni's duality), with the law
     ``rectified velocity error rate = −c · θ0 A cos ψ (Ωh)^order`` along the axis normal
     to both vibrations, ``c`` and ``order`` those of the coning drift.
+``coning-force``
+    The sculling conditions *and* those of a body coning (half angle ``a``, cone rate
+    ``Ω``) in a constant specific force ``f`` along the cone axis
+    (:class:`strapdown.truth.coning_force.ConingInForce`), interleaved by power of ``x``
+    (:func:`_coning_force_series`): the sculling target has no coning × constant-force term,
+    and the whole-update ``⅙ α × (α × υ)`` is exact for a constant rate only. Law (leading
+    order in ``a``): rectified velocity error rate along the cone axis
+    ``= −c · a² f (Ωh)^order``; ``order``/``drift_constant`` of the design are this law's
+    (:func:`velocity_error_laws` gives both). A pair sum whose coefficients the sculling
+    conditions fix (cross-with-last, the single chain) cannot meet these conditions beyond
+    ``(Ωh)⁴``; all pairs of the N subsamples can, to the sculling order ``2N``.
 
 Classical-coning analysis (leading order in the half-cone angle ``a``)
 ---------------------------------------------------------------------
@@ -93,11 +104,12 @@ __all__ = [
     "structure_by_name",
     "three_period_structure",
     "uncompressed_structure",
+    "velocity_error_laws",
 ]
 
 F = Fraction
 #: What a derivation cancels (see the module docstring).
-DesignTarget = Literal["coning", "polynomial", "sculling"]
+DesignTarget = Literal["coning", "polynomial", "sculling", "coning-force"]
 TARGETS: tuple[DesignTarget, ...] = get_args(DesignTarget)
 #: How coefficients the target leaves free are settled.
 DesignRule = Literal["polynomial", "min-norm"]
@@ -429,6 +441,51 @@ def _sculling_series(st: Structure, m: int):
     return e0, pair
 
 
+def _coning_force_series(st: Structure, m: int):
+    """Rectified cone-axis velocity error per update of a body coning in a constant specific
+    force ``f`` along the cone axis, over ``a² f / Ω``, as series in x (leading order in a).
+
+    Increments of node ``n``: ``θ_c = sin a e^{iφ} d_n``, ``v_c = f θ_c`` (body y + iz; the
+    transverse rate and force are parallel), ``θ_x = −2 sin²(a/2) x``, ``v_x = f cos a x``.
+    The update's ``Δv_b`` is rotated to the navigation frame by ``C_n_b(t0)``, whose cone-axis
+    row is ``(cos a, sin a Im(e^{−iφ} ·))``: the O(a) transverse error counts through the
+    tilt. Exactly, ``½ α × υ`` has no cone-axis part and ``(α × υ)_c = −i f U x α_c``;
+    ``⅙ α × (α × υ)`` gives ``−(1/6) f U x |α_c|²``; a pair ``k (θ_i × v_j + v_i × θ_j)``
+    gives ``2 Im(conj(d_i) d_j)`` along the axis and ``i f x (θ_{c,j} − θ_{c,i})`` across it.
+    Against the exact ``f U x``:
+    ``e0 = −(Ux − sin Ux) + (1/6) Ux (1 − cos Ux)``, pair ``(i, j)``:
+    ``2 Im(conj(d_i) d_j) + x Re(d_j − d_i)`` — the first part is twice the sculling pair
+    series (a lag function), the second depends on where the pair sits in the update.
+    """
+    _, p_s = _sculling_series(st, m)  # checks increment input and tiling
+    u = F(st.update)
+    one = [F(1)] + [F(0)] * m
+    re = [_add(_cos(s + 1, m), _scale(_cos(s, m), -1)) for s in st.nodes]
+    pair = [_add(_scale(p, 2), _shift(_add(re[j], _scale(re[i], -1)), 1))
+            for p, (i, j) in zip(p_s, st.pairs, strict=True)]
+    ux = _shift(_scale(one, u), 1)
+    e0 = _add(_scale(_add(ux, _scale(_sin(u, m), -1)), -1),
+              _scale(_mul(ux, _add(one, _scale(_cos(u, m), -1)), m), F(1, 6)))
+    return e0, pair
+
+
+def velocity_error_laws(structure: Structure, coefficients, *, terms: int = 30
+                        ) -> dict[str, tuple[int | None, Fraction | None]]:
+    """Leading classical-sculling and coning-in-force laws ``(order, constant)`` of any
+    velocity pair coefficients on an increment structure (one per pair, converted exactly):
+    ``{"sculling": …, "coning-force": …}``, the laws of the module docstring; ``(None,
+    None)`` when a series vanishes up to ``x^terms``."""
+    coeffs = tuple(F(c) for c in coefficients)
+    if len(coeffs) != len(structure.pairs):
+        raise ValueError(f"{len(structure.pairs)} coefficients expected (one per pair), got "
+                         f"{len(coeffs)}")
+    out = {}
+    for name, fn in (("sculling", _sculling_series), ("coning-force", _coning_force_series)):
+        e0, ps = fn(structure, terms)
+        out[name] = _leading(structure, coeffs, e0, ps, terms)
+    return out
+
+
 def _poly_conditions(st: Structure):
     """Rows (per pair) and targets of the polynomial-rate conditions, lowest degree first."""
     k = len(st.nodes)
@@ -514,7 +571,7 @@ class Design:
     Attributes
     ----------
     structure : Structure
-    target : {"coning", "polynomial", "sculling"}
+    target : {"coning", "polynomial", "sculling", "coning-force"}
     rule : str
         How remaining freedom was settled.
     coefficients : tuple of Fraction
@@ -603,8 +660,8 @@ class Design:
             "terms": list(self.terms),
             "drift_constant": None if self.drift_constant is None else _fs(self.drift_constant),
             "order": self.order,
-            "drift_law": (_SCULLING_LAW if self.target == "sculling" else
-                          "drift about the cone axis = −drift_constant · a²Ω(Ωh)^order"),
+            "drift_law": _LAWS.get(self.target,
+                                   "drift about the cone axis = −drift_constant · a²Ω(Ωh)^order"),
             "quadrature_included": self.quadrature_included,
         }
         if self.structure.triples:
@@ -620,6 +677,9 @@ class Design:
 
 _SCULLING_LAW = ("rectified velocity error rate along the axis normal to both vibrations = "
                  "−drift_constant · θ0 A cos ψ (Ωh)^order")
+_FORCE_LAW = ("rectified velocity error rate along the cone axis of a body coning in a "
+              "constant specific force f along that axis = −drift_constant · a² f (Ωh)^order")
+_LAWS = {"sculling": _SCULLING_LAW, "coning-force": _FORCE_LAW}
 
 
 def _leading(st, coeffs, e0, pair_series, m):
@@ -722,7 +782,7 @@ def derive(structure: Structure, *, target: DesignTarget = "coning",
     Parameters
     ----------
     structure : Structure
-    target : {"coning", "polynomial", "sculling"}
+    target : {"coning", "polynomial", "sculling", "coning-force"}
         ``sculling``: increment structures only (ValueError for rate input).
     rule : {"polynomial", "min-norm"}
         How to settle coefficients the target leaves free.
@@ -756,6 +816,8 @@ def _derive(st: Structure, target: DesignTarget, rule: DesignRule, quadrature: b
     m = 2 * ng + 2 * max(len(st.nodes), 2) + 9
     if target == "sculling":
         e0, pair_series = _sculling_series(st, m)
+    elif target == "coning-force":
+        e0, pair_series = _coning_force_series(st, m)
     else:
         e0, pair_series = _coning_series(st, m, quadrature=quadrature)
     grp_series = [[sum(g[k][col] * pair_series[k][p] for k in range(npair)) for p in range(m + 1)]
@@ -765,7 +827,13 @@ def _derive(st: Structure, target: DesignTarget, rule: DesignRule, quadrature: b
     poly_rows_p, poly_rhs, _ = _poly_conditions(st)
     poly_rows = [[sum(r[k] * g[k][c] for k in range(npair)) for c in range(ng)]
                  for r in poly_rows_p]
-    if target in ("coning", "sculling"):
+    if target == "coning-force":  # sculling and force conditions, power by power
+        e_s, p_s = _sculling_series(st, m)
+        rows_s = [[sum(g[k][c] * p_s[k][p] for k in range(npair)) for c in range(ng)]
+                  for p in range(m + 1)]
+        con_rows = [r for p in range(m + 1) for r in (rows_s[p], con_rows[p])]
+        con_rhs = [v for p in range(m + 1) for v in (-e_s[p], con_rhs[p])]
+    if target != "polynomial":
         a, b = _prefix_solve(con_rows, con_rhs)
         conditions = len(a)
         if rule == "polynomial":
@@ -777,5 +845,5 @@ def _derive(st: Structure, target: DesignTarget, rule: DesignRule, quadrature: b
     ug = [_frac(v) for v in u]
     coeffs = tuple(sum((g[k][c] * ug[c] for c in range(ng)), F(0)) for k in range(npair))
     order, const = _leading(st, coeffs, e0, pair_series, m)
-    rule_used = rule if target in ("coning", "sculling") else "min-norm"
+    rule_used = rule if target != "polynomial" else "min-norm"
     return Design(st, target, rule_used, coeffs, order, const, quadrature, conditions)
