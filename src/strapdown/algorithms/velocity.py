@@ -89,6 +89,7 @@ __all__ = [
     "VelocitySet",
     "body_increments",
     "coning_force_law",
+    "effective_velocity_set",
     "integrate_inertial",
     "integrate_inertial_mp",
     "integrate_inertial_rates",
@@ -157,14 +158,21 @@ class ConingForceLaw:
         return -float(self.constant) * half_angle**2 * force * (cone_rate * h) ** self.order
 
 
+def effective_velocity_set(structure: NavStructure,
+                           velocity_set: VelocitySet = DEFAULT_VELOCITY_SET) -> VelocitySet:
+    """The set a structure runs for the name given: the single chain has one set, the
+    classical one (module docstring)."""
+    return "classical" if _structure(structure) == "single-chain" else _velocity_set(
+        velocity_set)
+
+
 def coning_force_law(n: int, structure: NavStructure = "conventional",
                      velocity_set: VelocitySet = DEFAULT_VELOCITY_SET) -> ConingForceLaw:
     """The coning-in-constant-force law of a structure's velocity set
     (:data:`tables.CONING_FORCE_DRIFT`; the single chain has one set)."""
-    n, structure = _n(n), _structure(structure)
-    key = (structure, "classical" if structure == "single-chain"
-           else _velocity_set(velocity_set))
-    order, c = tables.CONING_FORCE_DRIFT[key][n]
+    n = _n(n)
+    order, c = tables.CONING_FORCE_DRIFT[(structure, effective_velocity_set(
+        structure, velocity_set))][n]
     return ConingForceLaw(order, c)
 
 

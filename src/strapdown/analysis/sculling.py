@@ -19,12 +19,21 @@ duals ``rate-single``/``rate-three`` on rate and specific-force samples, float64
 :func:`strapdown.algorithms.velocity.rate_sculling_law`), first order
 in θ0 — at a realistic amplitude the θ0³ terms it leaves out may dominate (see
 ``strapdown reproduce sculling``).
+
+``--motion coning-force`` (:func:`evaluate_coning_force`) is a body coning (half angle
+``a`` = ``half_angle_deg``, ``Ω`` = 2π ``cone_rate_hz``) in a constant specific force
+``f`` = ``accel_amplitude`` m/s² along the cone axis — a body at rest in gravity coning
+about the vertical (:class:`strapdown.truth.coning_force.ConingInForce`, exact increments).
+Same algorithms, rate and outputs; the law is the coning-in-force one,
+``−c · a² f (Ωh)^order`` along the cone axis (navigation x), with the default velocity set
+(:func:`strapdown.algorithms.velocity.coning_force_law`: order 2N for the conventional
+structure, 4 for the single chain), leading order in ``a``.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
@@ -35,6 +44,8 @@ from strapdown.algorithms.velocity import (
     NAV_STRUCTURES,
     RATE_VELOCITY_ALGORITHMS,
     NavStructure,
+    coning_force_law,
+    effective_velocity_set,
     integrate_inertial,
     integrate_inertial_mp,
     integrate_inertial_rates,
@@ -47,7 +58,8 @@ from strapdown.truth.sculling import ScullingMotion, classical_sculling
 if TYPE_CHECKING:
     from strapdown.analysis.evaluate import EvaluationConfig
 
-__all__ = ["ScullingEvaluation", "build_sculling", "evaluate_sculling", "validate_sculling"]
+__all__ = ["ScullingEvaluation", "build_coning_force", "build_sculling", "evaluate_coning_force",
+           "evaluate_sculling", "validate_coning_force", "validate_sculling"]
 
 #: Most samples an arbitrary-precision sculling run takes (each sample is a few hundred
 #: multi-precision operations; 10⁵ at 40 digits take about a minute).
@@ -148,13 +160,16 @@ class ScullingEvaluation:
     predicted: NDArray[np.float64] | None
     update_period: float
     samples: int
+    extra: dict[str, Any] = field(default_factory=dict)
 
     @property
     def measured_over_law(self) -> float | None:
-        """Measured / law along navigation z (None without a law or with a zero law)."""
-        if self.predicted is None or self.predicted[2] == 0.0:
+        """Measured / law along the law's axis (navigation z for sculling, x for coning in
+        a force; None without a law or with a zero law)."""
+        if self.predicted is None or not np.any(self.predicted):
             return None
-        return float(self.rate[2] / self.predicted[2])
+        k = int(np.argmax(np.abs(self.predicted)))
+        return float(self.rate[k] / self.predicted[k])
 
     def to_dict(self) -> dict[str, Any]:
         """The documented JSON record."""
@@ -175,7 +190,7 @@ class ScullingEvaluation:
             "max_velocity_error_m_s": float(np.max(np.linalg.norm(self.dv, axis=1))),
             "max_position_error_m": float(np.max(np.linalg.norm(self.dp, axis=1))),
             "update_period_s": self.update_period, "samples": self.samples,
-        }
+        } | self.extra
 
 
 def _errors(cfg: EvaluationConfig, motion: ScullingMotion, h: float,
@@ -222,5 +237,80 @@ def evaluate_sculling(cfg: EvaluationConfig) -> ScullingEvaluation:
         math.radians(cfg.angle_amplitude_deg), cfg.accel_amplitude, math.radians(cfg.phase_deg),
         2 * math.pi * cfg.frequency_hz, h)
     predicted = np.array([0.0, 0.0, law])
+    extra = {} if rate_input else {
+        "velocity_set": effective_velocity_set(cast(NavStructure, cfg.structure))}
     return ScullingEvaluation(cfg, t, dv, dp, np.asarray(est.rate, dtype=np.float64),
-                              est.method, est.points, predicted, period, samples)
+                              est.method, est.points, predicted, period, samples, extra)
+
+
+# ------------------------------------------------------------ coning in a constant force
+def validate_coning_force(cfg: EvaluationConfig) -> None:
+    """What the coning-in-force motion takes: the increment velocity algorithms (``rotvec``,
+    conventional or single-chain, N = 1–6, default sets), ideal sensors, a finite half angle
+    within ±90° and a non-zero cone rate resolved by the sample rate, a finite force; in
+    arbitrary precision the limits of :func:`validate_sculling`."""
+    from strapdown.algorithms.coning import MAX_SUBSAMPLES
+
+    if cfg.algorithm != "rotvec":
+        raise InputError(f"the coning-force motion runs the increment velocity algorithms "
+                         f"(rotvec, N = 1–{MAX_SUBSAMPLES}); {cfg.algorithm} has no law here")
+    if cfg.structure not in NAV_STRUCTURES:
+        raise InputError(f"the velocity algorithms run in the {' or '.join(NAV_STRUCTURES)} "
+                         f"structure, not {cfg.structure}")
+    if cfg.coefficients not in (None, "table3"):
+        raise InputError(f"the velocity algorithms use the designer's sets (coning: table3); "
+                         f"coefficients {cfg.coefficients} do not apply to this motion")
+    if not 1 <= cfg.subsamples <= MAX_SUBSAMPLES:
+        raise InputError(f"N (subsamples) must be 1–{MAX_SUBSAMPLES} for the velocity "
+                         f"algorithms, got {cfg.subsamples}")
+    if cfg.gyro is not None and not cfg.gyro.is_ideal:
+        raise InputError("the coning-force motion takes ideal sensors only (no gyro errors)")
+    a = _finite("half angle (deg)", cfg.half_angle_deg)
+    if not abs(a) < 90.0:
+        raise InputError(f"half angle must be within ±90° for coning in a force, got {a:g}")
+    _finite("force along the cone axis (m/s²)", cfg.accel_amplitude)
+    f = _finite("cone rate (Hz)", cfg.cone_rate_hz)
+    if f == 0.0:
+        raise InputError("cone rate must be non-zero")
+    if not 2 * math.pi * abs(f) / cfg.sample_rate_hz <= math.pi:
+        raise InputError(f"the cone rate {f:g} Hz is above half the sample rate "
+                         f"({cfg.sample_rate_hz:g} Hz; Nyquist)")
+    if cfg.precision is not None:
+        if cfg.precision < MIN_DIGITS:
+            raise InputError(f"precision must be at least {MIN_DIGITS} digits (float64 is "
+                             f"~16), got {cfg.precision}")
+        if cfg.samples > MAX_MP_SCULLING_SAMPLES:
+            raise InputError(f"{cfg.samples} samples in arbitrary precision; at most "
+                             f"{MAX_MP_SCULLING_SAMPLES} (shorten --duration or lower the rate)")
+
+
+def build_coning_force(cfg: EvaluationConfig):
+    """The coning-in-force motion a configuration names (SI units; force along the cone
+    axis, navigation x)."""
+    from strapdown.truth.coning_force import ConingInForce
+
+    return ConingInForce(math.radians(cfg.half_angle_deg), 2 * math.pi * cfg.cone_rate_hz,
+                         (float(cfg.accel_amplitude), 0.0, 0.0))
+
+
+def evaluate_coning_force(cfg: EvaluationConfig) -> ScullingEvaluation:
+    """The velocity algorithm on a body coning in a constant specific force (module
+    docstring): rectified velocity-error rate (m/s², navigation frame; the cone axis is x)
+    against the coning-in-force law, on whole cone periods from the first on."""
+    validate_coning_force(cfg)
+    motion = build_coning_force(cfg)
+    t, dv, dp, start, period = _errors(cfg, motion, cfg.h, cfg.samples)
+    cone = 2 * math.pi / abs(motion.cone_rate)
+    ref = max(t[start], cone) if t[-1] >= 2 * cone else t[start]
+    sel = t >= ref - 1e-9 * cone
+    if np.count_nonzero(sel) < 2:
+        sel = np.ones(t.size, dtype=bool)
+    est = drift_rate(t[sel], dv[sel], period=cone, reference_time=ref, h=period)
+    law = coning_force_law(cfg.subsamples, cast(NavStructure, cfg.structure)).predict(
+        motion.half_angle, motion.axial_force(), motion.cone_rate, cfg.h)
+    predicted = np.array([law, 0.0, 0.0])
+    extra = {"half_angle_deg": cfg.half_angle_deg, "cone_rate_hz": cfg.cone_rate_hz,
+             "force_along_cone_axis_m_s2": cfg.accel_amplitude,
+             "velocity_set": effective_velocity_set(cast(NavStructure, cfg.structure))}
+    return ScullingEvaluation(cfg, t, dv, dp, np.asarray(est.rate, dtype=np.float64),
+                              est.method, est.points, predicted, period, cfg.samples, extra)
