@@ -38,7 +38,7 @@ def test_kernel_rates_are_the_earth_model():
                                                           earth.GE, earth.GK, earth.GM_RATIO)
     out = np.empty(9)
     v = np.array([80.0, -60.0, 5.0])
-    _nav_kernels._rates(0.7, 1234.0, v, out)
+    _nav_kernels._rates(0.7, 1234.0, v, out, 1.0)
     wie = earth.earth_rate(0.7)
     win = wie + earth.transport_rate(0.7, 1234.0, v)
     rn, re = earth.radii(0.7, 1234.0)

@@ -169,9 +169,10 @@ def _cross(a, b, out):
 
 
 @njit(cache=True, inline="always")
-def _rates(lat, hgt, v, out):
+def _rates(lat, hgt, v, out, quad):
     """out[0:3] = ω_in, out[3:6] = γ − (ω_ie + ω_in) × v (gravity and Coriolis),
-    out[6:9] = (L̇, λ̇, ḣ) at the state (lat, hgt, v)."""
+    out[6:9] = (L̇, λ̇, ḣ) at the state (lat, hgt, v); ``quad`` 1.0 keeps normal gravity's
+    second-order height term, 0.0 drops it (the linear height correction)."""
     s = np.sin(lat)
     cl = np.cos(lat)
     s2 = s * s
@@ -181,7 +182,7 @@ def _rates(lat, hgt, v, out):
     e1 = _A / sq + hgt
     g0 = _GE * (1.0 + _GK * s2) / sq
     gam = g0 * (1.0 - 2.0 / _A * (1.0 + _F + _GM_RATIO - 2.0 * _F * s2) * hgt
-                + 3.0 * hgt * hgt / (_A * _A))
+                + quad * (3.0 * hgt * hgt / (_A * _A)))
     wie0 = _OMEGA * cl
     wie2 = -_OMEGA * s
     out[0] = wie0 + v[1] / e1
@@ -220,12 +221,13 @@ def _extrap(k, b, c, d):
 
 
 @njit(cache=True)
-def earth_nav_kernel(phi, dvb, period, lat0, lon0, h0, v0, q0, pos_out, v_out, q_out):
+def earth_nav_kernel(phi, dvb, period, lat0, lon0, h0, v0, q0, pos_out, v_out, q_out, quad):
     """NED navigation on the WGS-84 Earth from body increments (see
     :mod:`strapdown.algorithms.navigation` for the equations).
 
     pos_out (M + 1, 3) latitude, longitude (rad), height (m); v_out (M + 1, 3) NED m/s;
-    q_out (M + 1, 4) q_n_b. Row 0 is the initial state.
+    q_out (M + 1, 4) q_n_b. Row 0 is the initial state. ``quad``: 1.0 normal gravity with
+    the second-order height correction, 0.0 with the linear one (:func:`_rates`).
     """
     pos_out[0, 0] = lat0
     pos_out[0, 1] = lon0
@@ -233,11 +235,11 @@ def earth_nav_kernel(phi, dvb, period, lat0, lon0, h0, v0, q0, pos_out, v_out, q
     v_out[0, :] = v0
     q_out[0, :] = q0
     hist = np.zeros((3, 12))
-    earth_nav_chunk_kernel(phi, dvb, period, hist, 0, pos_out, v_out, q_out)
+    earth_nav_chunk_kernel(phi, dvb, period, hist, 0, pos_out, v_out, q_out, quad)
 
 
 @njit(cache=True)
-def earth_nav_chunk_kernel(phi, dvb, period, hist, nh, pos_out, v_out, q_out):
+def earth_nav_chunk_kernel(phi, dvb, period, hist, nh, pos_out, v_out, q_out, quad):
     """:func:`earth_nav_kernel` continuing a run: rows 0 of the outputs hold the state the
     chunk starts from (filled by the caller); ``hist`` (3, 12) the Earth rates
     (:func:`_rates`, columns 0–8) and the body-frame velocity increment ``Δv_b``
@@ -260,7 +262,7 @@ def earth_nav_chunk_kernel(phi, dvb, period, hist, nh, pos_out, v_out, q_out):
     pp = np.empty(3)
     qb = np.empty(4)
     if nh == 0:
-        _rates(pos_out[0, 0], pos_out[0, 2], v_out[0], hist[0])
+        _rates(pos_out[0, 0], pos_out[0, 2], v_out[0], hist[0], quad)
         nh = 1
     for m in range(phi.shape[0]):
         p = pos_out[m]
@@ -297,7 +299,7 @@ def earth_nav_chunk_kernel(phi, dvb, period, hist, nh, pos_out, v_out, q_out):
         for c in range(3):
             pp[c] = p[c] + period * _am(k, pred[6 + c], hist[0, 6 + c], hist[1, 6 + c],
                                         hist[2, 6 + c])
-        _rates(pp[0], pp[2], vn, end)
+        _rates(pp[0], pp[2], vn, end, quad)
         w = 0.5 if k == 2 else (5.0 / 12.0 if k == 3 else 0.375)
         for c in range(3):
             vn[c] += period * w * (end[3 + c] - pred[3 + c])

@@ -102,9 +102,9 @@ def inertial(body, period, q0, v0, p0, m: Backend):
 
 
 # ---------------------------------------------------------------------- WGS-84 navigation
-def earth_rates(lat, hgt, v, m: Backend):
+def earth_rates(lat, hgt, v, m: Backend, quad=1):
     """Twin of :func:`strapdown.algorithms._nav_kernels._rates`: ω_in, gravity and
-    Coriolis, (L̇, λ̇, ḣ) as one 9-tuple."""
+    Coriolis, (L̇, λ̇, ḣ) as one 9-tuple (``quad = 0``: linear height correction)."""
     from strapdown.truth import earth
 
     s, cl = m.sin(lat), m.cos(lat)
@@ -115,7 +115,7 @@ def earth_rates(lat, hgt, v, m: Backend):
     e1 = earth.A / sq + hgt
     g0 = earth.GE * (1 + earth.GK * s2) / sq
     gam = g0 * (1 - 2 / earth.A * (1 + earth.F + earth.GM_RATIO - 2 * earth.F * s2) * hgt
-                + 3 * hgt * hgt / (earth.A * earth.A))
+                + quad * (3 * hgt * hgt / (earth.A * earth.A)))
     wie0, wie2 = earth.OMEGA * cl, -earth.OMEGA * s
     win = (wie0 + v[1] / e1, -v[0] / e0, wie2 - v[1] * (s / cl) / e1)
     w = (wie0 + win[0], win[1], wie2 + win[2])
@@ -148,13 +148,13 @@ def left_update(zeta, q, m: Backend):
     return tuple(x * inv for x in out)
 
 
-def earth_nav(body, period, pos0, v0, q0, m: Backend):
+def earth_nav(body, period, pos0, v0, q0, m: Backend, quad=1):
     """Twin of :func:`strapdown.algorithms._nav_kernels.earth_nav_kernel` on a list of
     ``(φ, Δv_b)``: lists of positions, velocities and ``q_n_b`` (row 0 the initial state).
     The same equations; the navigation-frame rotation by its exponential (the kernel takes
     a series below |ζ|/2 = 1e-2, equal to rounding)."""
     ps, vs, qs = [tuple(pos0)], [tuple(v0)], [tuple(q0)]
-    hist = [earth_rates(pos0[0], pos0[2], v0, m) + (0 * period,) * 3]
+    hist = [earth_rates(pos0[0], pos0[2], v0, m, quad) + (0 * period,) * 3]
     for phi, dvb in body:
         p, v, q = ps[-1], vs[-1], qs[-1]
         k = len(hist) + 1
@@ -172,7 +172,7 @@ def earth_nav(body, period, pos0, v0, q0, m: Backend):
         vp = [v[c] + (x[c] - 0.5 * t1[c] - t3[c] / 12 + t4[c] / 6 - (t5[c] - t6[c]) / 12)
               + period * _am(k, pred[3 + c], *col[3 + c]) for c in range(3)]
         pp = [p[c] + period * _am(k, pred[6 + c], *col[6 + c]) for c in range(3)]
-        end = earth_rates(pp[0], pp[2], vp, m)
+        end = earth_rates(pp[0], pp[2], vp, m, quad)
         w = 0.5 if k == 2 else (5 / 12 if k == 3 else 0.375)
         vn = tuple(vp[c] + period * w * (end[3 + c] - pred[3 + c]) for c in range(3))
         ps.append(tuple(p[c] + period * _am(k, end[6 + c], *col[6 + c]) for c in range(3)))
