@@ -11,7 +11,8 @@ import pytest
 from golden_configs import CONFIGS
 
 from c_harness import compiler
-from strapdown.codegen.export_c import ALGORITHMS, generate
+from strapdown.codegen.ahrs_c import generate_ahrs
+from strapdown.codegen.export_c import AHRS_ALGORITHMS, ALGORITHMS, generate
 
 GOLDEN = Path(__file__).parent / "golden"
 STRICT = ["-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-Wconversion"]
@@ -53,7 +54,24 @@ def test_no_unprefixed_type_or_macro(kw):
 
 
 def test_golden_covers_every_algorithm():
-    assert {kw["algorithm"] for kw in CONFIGS} == set(ALGORITHMS)
+    # the AHRS is new (no old output to hold): its own tests, and the compile test below
+    assert {kw["algorithm"] for kw in CONFIGS} == set(ALGORITHMS) - set(AHRS_ALGORITHMS)
+
+
+#: AHRS modules: float and double, with and without magnetometer, and RK4 in float
+AHRS = [{"real": r, "mag": m} for r in ("double", "float") for m in (True, False)] + [
+    {"real": "float", "mag": True, "algorithm": "rk4"}]
+
+
+@pytest.mark.parametrize("kw", AHRS, ids=_id)
+def test_ahrs_has_no_unprefixed_type_or_macro(kw):
+    e = generate_ahrs(200.0, **kw, name="my_ahrs")
+    for text in (e.header, e.source):
+        assert not re.search(r"\breal_t\b", text)
+        for macro in re.findall(r"#\s*define\s+(\w+)", text):
+            assert macro.startswith("MY_AHRS_"), macro
+        for typ in re.findall(r"typedef\s+(?:struct\s*\{[^}]*\}|[^;{]*?)\s*(\w+)\s*;", text):
+            assert typ.startswith("my_ahrs_"), typ
 
 
 def test_float_and_double_modules_compile_together(tmp_path):
@@ -66,7 +84,11 @@ def test_float_and_double_modules_compile_together(tmp_path):
         (tmp_path / f"{e.name}.c").write_text(e.source)
         mods.append(e)
     assert {e.real for e in mods} == {"float", "double"}
-    lines = [f'#include "{e.name}.h"' for e in mods] + ["#include <stdio.h>", "",
+    ahrs = [generate_ahrs(100.0, **kw, name=f"a{i}_ahrs") for i, kw in enumerate(AHRS)]
+    for e in ahrs:
+        (tmp_path / f"{e.name}.h").write_text(e.header)
+        (tmp_path / f"{e.name}.c").write_text(e.source)
+    lines = [f'#include "{e.name}.h"' for e in [*mods, *ahrs]] + ["#include <stdio.h>", "",
                                                          "int main(void)", "{", "    int n = 0;"]
     for e in mods:
         r = f"{e.name}_real"
@@ -89,11 +111,19 @@ def test_float_and_double_modules_compile_together(tmp_path):
             lines.append(f"        {e.name}_reset(&s);")
         lines.append(f"        if (sizeof s != {e.name}_state_size()) return 1;")
         lines.append("    }")
+    for e in ahrs:
+        r = f"{e.name}_real"
+        lines += ["    {", f"        static {e.name}_state s;", f"        {r} q[4];",
+                  f"        const {r} g[3] = {{0.01f, 0, 0}}, a[3] = {{0, 0, 9.8f}}, "
+                  "m[3] = {0, 20, -40};",
+                  "        int k;", f"        {e.name}_init(&s);",
+                  f"        for (k = 0; k < 120; ++k) n += {e.name}_update(&s, g, a, m, q) == 0;",
+                  f"        if (sizeof s != {e.name}_state_size()) return 1;", "    }"]
     lines += ['    printf("%d\\n", n);', "    return 0;", "}", ""]
     (tmp_path / "all.c").write_text("\n".join(lines))
     exe = tmp_path / "all"
     res = subprocess.run([compiler(), *STRICT, "-o", str(exe), str(tmp_path / "all.c"),
-                          *(str(tmp_path / f"{e.name}.c") for e in mods), "-lm"],
+                          *(str(tmp_path / f"{e.name}.c") for e in [*mods, *ahrs]), "-lm"],
                          capture_output=True, text=True, cwd=tmp_path)
     assert res.returncode == 0, res.stderr
     run = subprocess.run([str(exe)], capture_output=True, text=True)

@@ -26,7 +26,8 @@ def _arguments(p: argparse.ArgumentParser) -> None:
 
     p.add_argument("--algorithm", choices=ALGORITHMS, required=True,
                    help="the algorithm to generate (nav: the navigation update on the WGS-84 "
-                   "Earth with coning and sculling compensation)")
+                   "Earth with coning and sculling compensation; ahrs: the AHRS filter of "
+                   "strapdown ahrs, one update per IMU sample)")
     p.add_argument("--structure", choices=STRUCTURES, default="conventional",
                    help=structure_help(ATTITUDE_ALGORITHMS) + "; nav: conventional, single-chain")
     p.add_argument("--subsamples", type=int, default=None,
@@ -44,6 +45,23 @@ def _arguments(p: argparse.ArgumentParser) -> None:
                    help="C identifier prefix (default: derived from the configuration, e.g. "
                    "sd_rotvec_conventional_n3)")
     p.add_argument("--out", required=True, help="output directory")
+    g = p.add_argument_group("ahrs (the filter options of strapdown ahrs)")
+    g.add_argument("--propagation", default="rate-single",
+                   help="the AHRS's attitude propagation (strapdown ahrs --algorithm): "
+                   "rate-single (default), rate-two, rate-three, rk4")
+    g.add_argument("--no-mag", action="store_true",
+                   help="no magnetometer code (the filter without heading)")
+    g.add_argument("--no-gating", action="store_true",
+                   help="accept every measurement (no innovation gating or disturbance checks)")
+    g.add_argument("--gyro-sample", choices=["interval", "point"], default="interval",
+                   help="what a gyro sample is (as strapdown ahrs --gyro-sample)")
+    g.add_argument("--declination-deg", type=float, default=0.0,
+                   help="magnetic declination (deg, east positive)")
+    g.add_argument("--set", dest="config", action="append", default=[], metavar="FIELD=VALUE",
+                   help="any other AhrsConfig field (repeatable), e.g. --set rest_min_s=1.0 "
+                   "--set acc_model=raw")
+    g.add_argument("--no-count", action="store_true",
+                   help="skip measuring the operations per update (needs a C++ compiler)")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -51,6 +69,8 @@ def run(args: argparse.Namespace) -> int:
     from strapdown.algorithms.spec import family
     from strapdown.codegen.export_c import NAV_ALGORITHMS, export_c
 
+    if args.algorithm == "ahrs":
+        return _run_ahrs(args)
     if args.algorithm in NAV_ALGORITHMS:  # the sample interval is an argument of its init
         if args.sample_rate_hz is not None:
             raise ValueError("--sample-rate-hz does not apply to nav (its init takes the "
@@ -82,6 +102,64 @@ def run(args: argparse.Namespace) -> int:
                  **({} if h is None else {"h": h}))
     print(_wrote(args.out, e.name))
     print("operations per update: " + ", ".join(f"{k} {v}" for k, v in e.ops.items()))
+    return 0
+
+
+def _ahrs_config(args: argparse.Namespace):
+    """The AhrsConfig of the options (``--set`` values parsed as the field's type)."""
+    import dataclasses
+
+    from strapdown.ahrs import AhrsConfig
+
+    fields = {f.name: f for f in dataclasses.fields(AhrsConfig)}
+    kw: dict = {"gating": not args.no_gating, "declination_deg": args.declination_deg,
+                "gyro_sample": args.gyro_sample}
+    for item in args.config:
+        key, sep, value = item.partition("=")
+        if not sep or key not in fields:
+            raise ValueError(f"--set {item!r}: expected FIELD=VALUE with an AhrsConfig field "
+                             f"({', '.join(fields)})")
+        default = getattr(AhrsConfig(), key)
+        if isinstance(default, bool):
+            if value.lower() not in ("true", "false", "1", "0"):
+                raise ValueError(f"--set {key}: expected true or false, got {value!r}")
+            kw[key] = value.lower() in ("true", "1")
+        else:
+            kw[key] = value if isinstance(default, str) else float(value)
+    return AhrsConfig(**kw)
+
+
+def _run_ahrs(args: argparse.Namespace) -> int:
+    """``--algorithm ahrs``: write the module, print its state size and operation counts."""
+    from strapdown.codegen.ahrs_c import export_ahrs
+
+    if args.sample_rate_hz is None or not args.sample_rate_hz > 0:
+        raise ValueError("ahrs bakes the IMU's sample rate into the code: pass a positive "
+                         "--sample-rate-hz (Hz)")
+    for opt, given in (("--structure", args.structure != "conventional"),
+                       ("--subsamples", args.subsamples is not None),
+                       ("--coefficients", args.coefficients is not None)):
+        if given:
+            raise ValueError(f"{opt} does not apply to ahrs (its propagation is --propagation)")
+    e = export_ahrs(args.out, sample_rate_hz=args.sample_rate_hz, real=args.real,
+                    mag=not args.no_mag, algorithm=args.propagation, config=_ahrs_config(args),
+                    name=args.name)
+    print(_wrote(args.out, e.name))
+    print(f"initial window: {e.init_samples} samples (init_window_s)")
+    if args.no_count:
+        return 0
+    from strapdown.codegen.ahrs_count import count_operations, state_size
+
+    try:
+        print(f"state: {state_size(e)} bytes ({e.name}_state, this machine's C compiler)")
+        c = count_operations(e)
+    except RuntimeError as exc:
+        print(f"not measured: {exc}")
+        return 0
+    print("operations per update, mean (max) over a simulated recording: " + ", ".join(
+        f"{k} {c.mean[k]:.0f} ({c.max[k]})" for k in c.mean))
+    print("the update that completes the initial window: " + ", ".join(
+        f"{k} {v}" for k, v in c.window.items()))
     return 0
 
 

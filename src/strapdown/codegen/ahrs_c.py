@@ -33,7 +33,7 @@ from strapdown.ahrs import _kernel as K
 from strapdown.ahrs import filter as F
 from strapdown.ahrs.flags import MeasurementFlag
 
-__all__ = ["LEARNED", "AhrsExport", "generate_ahrs", "propagation_supported"]
+__all__ = ["LEARNED", "AhrsExport", "export_ahrs", "generate_ahrs", "propagation_supported"]
 
 _TEMPLATES = Path(__file__).parent / "templates"
 #: Params fields the filter learns from the record (state, not constants); the low-pass
@@ -221,3 +221,17 @@ def generate_ahrs(sample_rate_hz: float | None = None, *, h: float | None = None
     source = body.replace("@CONSTANTS@", _constants(cfg, params, prop, h, mag, real))
     return AhrsExport(name, _fill(header, name), _fill(source, name), real, h, mag,
                       algorithm, cfg, n_init)
+
+
+def export_ahrs(out: str | Path, **kwargs) -> AhrsExport:
+    """Generate (:func:`generate_ahrs`) and write ``<name>.h`` and ``<name>.c`` into ``out``
+    (each atomically)."""
+    from strapdown.io.files import write_text
+
+    exp = generate_ahrs(**kwargs)
+    out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise ValueError(f"--out {out} exists and is not a directory")
+    write_text(out / f"{exp.name}.h", exp.header)
+    write_text(out / f"{exp.name}.c", exp.source)
+    return exp

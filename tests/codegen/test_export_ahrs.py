@@ -1,0 +1,202 @@
+"""The generated AHRS C (``export-c --algorithm ahrs``) against the library's ``ekf``, row by
+row: double to 1e-8 rad at every sample (the harness that catches a kernel change the C
+does not follow), float within 0.05° mean and 0.5° max, on the shared BROAD trials and on
+simulated recordings over the filter's options."""
+
+from __future__ import annotations
+
+import math
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+from ahrs_harness import Stream, angle, build, run
+
+from conftest import BROAD
+from strapdown.ahrs import AhrsConfig, ekf
+from strapdown.ahrs import _kernel as K
+from strapdown.algorithms.rate import check_rate_record
+from strapdown.codegen.ahrs_c import generate_ahrs
+from strapdown.rotation.dcm import dcm_from_quat
+from strapdown.truth.motions import SpinConing
+
+TEMPLATE = Path(K.__file__).parents[1] / "codegen" / "templates" / "ahrs.c.in"
+WAIT, ERR_INPUT, ERR_NUMERIC = 1, -1, -3
+DOUBLE_RAD = 1e-8
+FLOAT_MEAN_DEG, FLOAT_MAX_DEG = 0.05, 0.5
+TRIALS = sorted(BROAD.glob("*.mat")) if BROAD is not None else []
+
+
+def _compare(res, q, rc, fl, w):
+    """Errors (rad) of the C rows against the library's from the window's last sample on;
+    the return codes and flags checked on the way."""
+    assert np.all(rc[: w - 1] == WAIT), np.unique(rc[: w - 1])
+    assert np.all(rc[w - 1:] == 0), np.unique(rc[w - 1:], return_counts=True)
+    return angle(res.q[w - 1:], q[w - 1:])
+
+
+@pytest.fixture(scope="module")
+def broad_builds(tmp_path_factory):
+    """Double and float modules for a sample period, built once per period (the trials'
+    periods, taken from their stamps as the library does, differ in the last bit)."""
+    folder = tmp_path_factory.mktemp("ahrs_broad")
+    cache: dict[float, dict] = {}
+
+    def get(h):
+        if h not in cache:
+            cache[h] = {real: build(folder / f"{len(cache)}", h=h, real=real,
+                                    name=f"broad_{real}") for real in ("double", "float")}
+        return cache[h]
+
+    return get
+
+
+@pytest.mark.skipif(BROAD is None, reason="BROAD data not found (set STRAPDOWN_BROAD)")
+@pytest.mark.parametrize("trial", TRIALS, ids=lambda p: p.stem[:2])
+def test_broad_trial_equals_library(trial, broad_builds):
+    from strapdown.io.broad import read_broad
+
+    tr = read_broad(trial)
+    h = check_rate_record(tr.t, tr.gyro, min_samples=4).td
+    res = ekf(tr.t, tr.gyro, tr.acc, tr.mag)
+    for real, (e, lib) in broad_builds(h).items():
+        q, rc, fl = run(e, lib, tr.gyro, tr.acc, tr.mag)
+        err = _compare(res, q, rc, fl, e.init_samples)
+        if real == "double":
+            assert err.max() <= DOUBLE_RAD, (err.max(), int(err.argmax()))
+            np.testing.assert_array_equal(fl[e.init_samples - 1:],
+                                          res.flags[e.init_samples - 1:])
+        else:
+            deg = np.degrees(err)
+            assert deg.mean() <= FLOAT_MEAN_DEG and deg.max() <= FLOAT_MAX_DEG, (deg.mean(),
+                                                                                deg.max())
+
+
+def simulated(n=6000, fs=200.0, seed=7, rest_s=5.0):
+    """A recording with exact motion, noise and a gyro bias: rest, then spin and coning; a
+    magnetic disturbance and a linear-acceleration burst on the way."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(n) / fs
+    m = SpinConing(math.radians(10.0), 2 * math.pi * 0.5, math.radians(20.0))
+    tm = np.maximum(t - rest_s, 0.0)
+    q = m.attitude(tm)
+    w = np.where((t > rest_s)[:, None], m.rate(tm), 0.0)
+    c = dcm_from_quat(q)
+    f_n = np.tile([0.0, 0.0, 9.80665], (n, 1))
+    burst = (t > 15) & (t < 16)
+    f_n[burst, 0] += 3.0
+    b_n = np.tile([0.0, 20.0, -40.0], (n, 1))
+    b_n[(t > 20) & (t < 23)] += [15.0, 0.0, 0.0]
+    acc = np.einsum("nji,nj->ni", c, f_n) + 0.02 * rng.normal(size=(n, 3))
+    mag = np.einsum("nji,nj->ni", c, b_n) + 0.3 * rng.normal(size=(n, 3))
+    gyro = w + [0.01, -0.005, 0.003] + 1e-3 * rng.normal(size=(n, 3))
+    return t, gyro, acc, mag
+
+
+SIM = simulated()
+#: (algorithm, config changes, magnetometer): the options of ``strapdown ahrs``, 1:1
+OPTIONS = [
+    ("rate-single", {}, True),
+    ("rate-single", {}, False),
+    ("rate-three", {}, True),
+    ("rate-two", {}, True),
+    ("rk4", {}, True),
+    ("rate-single", {"acc_model": "raw"}, True),
+    ("rate-single", {"estimate_acc_bias": True}, True),
+    ("rate-single", {"acc_model": "raw", "estimate_acc_bias": True, "acc_gate_mode": "soft"},
+     True),
+    ("rate-single", {"gyro_sample": "point", "latency_s": 0.01}, True),
+    ("rate-single", {"gating": False, "declination_deg": 12.5}, True),
+    ("rate-single", {"estimate_mag_delay": False, "mag_delay_s": 0.02,
+                     "mag_disturbed_power": 1.0, "heading_rate_noise": 1e-3}, True),
+    ("rate-single", {"rest_update": False, "use_accelerometer": False}, True),
+]
+
+
+@pytest.mark.parametrize("algorithm,changes,mag", OPTIONS,
+                         ids=lambda v: v if isinstance(v, str) else None)
+def test_simulated_equals_library(tmp_path, algorithm, changes, mag):
+    t, gyro, acc, m = SIM
+    cfg = AhrsConfig(**changes)
+    res = ekf(t, gyro, acc, m if mag else None, algorithm=algorithm, config=cfg)
+    h = check_rate_record(t, gyro, min_samples=4).td
+    for real in ("double", "float"):
+        e, lib = build(tmp_path, h=h, real=real, mag=mag, algorithm=algorithm, config=cfg,
+                       name=f"sim_{real}")
+        q, rc, fl = run(e, lib, gyro, acc, m if mag else None)
+        err = _compare(res, q, rc, fl, e.init_samples)
+        if real == "double":
+            assert err.max() <= DOUBLE_RAD, (err.max(), int(err.argmax()))
+            np.testing.assert_array_equal(fl[e.init_samples - 1:],
+                                          res.flags[e.init_samples - 1:])
+        else:
+            deg = np.degrees(err)
+            assert deg.mean() <= FLOAT_MEAN_DEG and deg.max() <= FLOAT_MAX_DEG
+
+
+def test_chunks_equal_one_stream(tmp_path):
+    # the state is all the filter keeps: any split of the record gives the same rows
+    _t, gyro, acc, mag = SIM
+    e, lib = build(tmp_path, h=1 / 200.0, name="chunks")
+    whole = run(e, lib, gyro, acc, mag)[0]
+    s = Stream(e, lib)
+    parts = [s.feed(gyro[a:b], acc[a:b], mag[a:b])[0]
+             for a, b in ((0, 1), (1, 150), (150, 3001), (3001, 6000))]
+    np.testing.assert_array_equal(np.concatenate(parts), whole)
+
+
+def test_bad_input_and_numerical_failure(tmp_path):
+    _t, gyro, acc, mag = SIM
+    e, lib = build(tmp_path, h=1 / 200.0, name="fail")
+    s = Stream(e, lib)
+    q, rc, _ = s.feed(gyro[:500], acc[:500], mag[:500])
+    assert rc[-1] == 0
+    bad = gyro[500:501].copy()
+    bad[0, 1] = np.nan
+    q2, rc2, _ = s.feed(bad, acc[500:501], mag[500:501])
+    assert rc2[0] == ERR_INPUT and np.array_equal(q2[0], q[-1])  # sample ignored
+    # the next good sample continues as if the bad one had not come
+    ref = run(e, lib, np.r_[gyro[:500], gyro[501:510]], np.r_[acc[:500], acc[501:510]],
+              np.r_[mag[:500], mag[501:510]])[0]
+    q3 = s.feed(gyro[501:510], acc[501:510], mag[501:510])[0]
+    np.testing.assert_array_equal(q3, ref[500:])
+    # a rate that overflows the covariance: an error, the last good attitude, a new window
+    huge = np.full((1, 3), 1e300)
+    q4, rc4, _ = s.feed(huge, acc[510:511], mag[510:511])
+    assert rc4[0] == ERR_NUMERIC and np.array_equal(q4[0], q3[-1])
+    _, rc5, _ = s.feed(gyro[511:520], acc[511:520], mag[511:520])
+    assert np.all(rc5 == WAIT)
+
+
+def test_refuses_what_it_cannot_run():
+    with pytest.raises(ValueError, match="sliding"):
+        generate_ahrs(100.0, algorithm="rate-three:structure=sliding")
+    with pytest.raises(ValueError, match="increments"):
+        generate_ahrs(100.0, algorithm="rotvec:N=3")
+    with pytest.raises(ValueError, match="one of them"):
+        generate_ahrs()
+
+
+#: kernel functions the C does not repeat, and why
+NOT_MIRRORED = {"_startup_step": "the sliding structure is not exported"}
+
+
+def test_every_kernel_function_has_its_mirror():
+    # a function added to the kernel must get its C twin (or a reason here)
+    kernel = re.findall(r"^def (\w+)\(", Path(K.__file__).read_text(), re.M)
+    text = TEMPLATE.read_text()
+    missing = [f for f in kernel if f not in NOT_MIRRORED and f"_kernel.{f}" not in text]
+    assert not missing, f"no C mirror (a comment '_kernel.NAME') for {missing}"
+
+
+def test_every_params_field_is_a_constant_or_learned():
+    from strapdown.codegen.ahrs_c import LEARNED
+
+    src = generate_ahrs(100.0).source
+    for f in K.Params._fields:
+        if f in LEARNED or f in ("store_covariance", "mag_delay_max", "rest_tau"):
+            continue
+        if f[:3] in ("lp_", "mc_") and f[3:] in ("b0", "b1", "b2", "a1", "a2"):
+            continue
+        assert re.search(rf"\.{f} = ", src), f
