@@ -1,6 +1,7 @@
 """`strapdown nav`'s output and the public navigation API (issue 26, item 4): Euler angles
 beside the quaternion, the initial-state row (bit for bit the library's row 0), the warning
-on a duplicated first increment row, the trailing partial update, ``import strapdown``."""
+on a duplicated first increment row, the trailing partial update, ``--gravity``,
+``import strapdown``."""
 
 from __future__ import annotations
 
@@ -146,8 +147,27 @@ def test_help_states_the_output_conventions(capsys):
     text = " ".join(capsys.readouterr().out.split())
     for phrase in ("yaw_deg,pitch_deg,roll_deg", "Row 0 is the initial state",
                    "first stamp - h for increments", "end of its interval", "--trailing",
-                   "duplicated first row"):
+                   "duplicated first row", "over the interval that ends at its stamp",
+                   "--gravity {wgs84,linear}", "linear height correction"):
         assert phrase in text, phrase
+
+
+def test_gravity_model_is_the_library_s_and_recorded(tmp_path, flight):
+    edges, g, a = flight
+    log = _write_csv(tmp_path / "log.csv", INC, edges[1:], g, a)
+    wgs, meta = _nav(tmp_path, log, "--subsamples", "2")
+    lin, meta_lin = _nav(tmp_path, log, "--subsamples", "2", "--gravity", "linear",
+                         out="lin.npz")
+    assert meta["gravity"] == "wgs84" and meta_lin["gravity"] == "linear"
+    q0 = quat_from_dcm(dcm_from_euler_zyx(*np.radians(YPR)))
+    sol = navigate(g, a, 2, h=H, lat=math.radians(52.0), lon=math.radians(-3.0), height=350.0,
+                   v0=[75.0, 27.0, 0.0], q0=q0, t0=0.0, gravity="linear")
+    got = np.load(lin)
+    assert np.array_equal(got["height_m"], sol.height) and np.array_equal(got["vd"], sol.v[:, 2])
+    # at 350 m the linear correction lacks 3 h²/a² γ0 = 8.9e-8 m/s²: after 5 s the vertical
+    # velocities differ by about that times 5 s
+    dvd = np.load(wgs)["vd"][-1] - got["vd"][-1]
+    assert 0.8 * 4.4e-7 < dvd < 1.2 * 4.4e-7
 
 
 def test_import_strapdown_exposes_the_navigation():

@@ -32,6 +32,10 @@ rate log of n samples gives n − 1 increments, so half of all logs leave one), 
 are an error naming how many are left (``trailing="error"``, ``--trailing error``). They
 were dropped silently before. The single chain updates every sample and never leaves any.
 
+Gravity: WGS-84 normal gravity (Somigliana) with the second-order height correction
+(``gravity="wgs84"``, ``--gravity wgs84``, the default) or its linear term only
+(``"linear"``), as :func:`strapdown.algorithms.navigation.navigate`.
+
 A duplicated first row: an increment log whose first two rows hold identical values (at
 different stamps: a common simulator export repeats the first row, and the extra
 increment costs 145 m in 10 min on a manoeuvre) warns (:class:`DuplicateRowWarning`, in
@@ -68,7 +72,7 @@ from tqdm import tqdm
 
 from strapdown._core.errors import InputError
 from strapdown._core.kinds import InputKind
-from strapdown.algorithms.navigation import NavStream
+from strapdown.algorithms.navigation import TRAILING_POLICIES, NavStream, TrailingPolicy
 from strapdown.algorithms.rate import JITTER_TOLERANCE as STAMP_TOLERANCE
 from strapdown.algorithms.velocity import NavStructure
 from strapdown.io import read_imu
@@ -97,6 +101,7 @@ from strapdown.io.timing import (
 )
 from strapdown.rotation.dcm import dcm_from_quat, quat_from_dcm
 from strapdown.rotation.euler import dcm_from_euler_zyx, euler_zyx_from_dcm
+from strapdown.truth.earth import GRAVITY_MODELS, GravityModel
 
 __all__ = ["ACC_UNITS", "HEIGHT_RANGE_M", "MAX_ANGLE_DEG", "MAX_LONGITUDE_DEG",
            "MAX_SPECIFIC_FORCE", "NAV_COLUMNS", "TRAILING_POLICIES", "AccUnit",
@@ -112,10 +117,6 @@ _ACC_ALLOWED: dict[InputKind, tuple[AccUnit, ...]] = {"rate": ("m/s2", "g"),
 #: (z-y-x of ``q_n_b`` in NED, deg) follow the quaternion.
 NAV_COLUMNS = ("t", "lat_deg", "lon_deg", "height_m", "vn", "ve", "vd", "qw", "qx", "qy", "qz",
                "yaw_deg", "pitch_deg", "roll_deg")
-#: What ``nav`` does with fewer than N samples left after the last whole conventional
-#: update: fail naming them (default), or navigate without them.
-TrailingPolicy = Literal["error", "drop"]
-TRAILING_POLICIES: tuple[TrailingPolicy, ...] = get_args(TrailingPolicy)
 G0 = 9.80665
 CHUNK = 1 << 15
 #: Largest specific force accepted (m/s², about 10⁶ g: beyond any accelerometer's range,
@@ -473,7 +474,8 @@ def navigate_log(imu: str | os.PathLike[str], out: str | os.PathLike[str], *, la
                  on_gap: NavGapPolicy = "error", timing: TimingMode = "auto",
                  jitter_tolerance: float = JITTER_TOLERANCE, held: HeldPolicy = "auto",
                  duplicates: DuplicatePolicy = "error",
-                 trailing: TrailingPolicy = "drop") -> dict[str, Any]:
+                 trailing: TrailingPolicy = "drop", gravity: GravityModel = "wgs84"
+                 ) -> dict[str, Any]:
     """Navigate a log and write the initial state and one row per update (see the module
     docstring).
 
@@ -494,6 +496,8 @@ def navigate_log(imu: str | os.PathLike[str], out: str | os.PathLike[str], *, la
     trailing : {"drop", "error"}
         Fewer than N samples left after the last whole conventional update: navigated
         without (counted in the summary; default), or an error naming them.
+    gravity : {"wgs84", "linear"}
+        Normal gravity's height correction (:func:`strapdown.truth.earth.gravity`).
 
     Returns
     -------
@@ -508,6 +512,9 @@ def navigate_log(imu: str | os.PathLike[str], out: str | os.PathLike[str], *, la
     if trailing not in TRAILING_POLICIES:
         raise InputError(f"trailing must be one of {', '.join(TRAILING_POLICIES)}, got "
                          f"{trailing!r}")
+    if gravity not in GRAVITY_MODELS:
+        raise InputError(f"gravity must be one of {', '.join(GRAVITY_MODELS)}, got "
+                         f"{gravity!r}")
     lat, lon, hgt, v0, q0 = _initial_state(lat_deg, lon_deg, height, velocity, attitude_deg)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -522,7 +529,7 @@ def navigate_log(imu: str | os.PathLike[str], out: str | os.PathLike[str], *, la
     else:
         g, a, t0 = log.gyro, log.accel, float(log.t[0]) - log.h
     stream = NavStream(subsamples, h=log.h, lat=lat, lon=lon, height=hgt, v0=v0, q0=q0,
-                       structure=structure, t0=t0, sculling=sculling)
+                       structure=structure, t0=t0, sculling=sculling, gravity=gravity)
     left = _trailing(g.shape[0], stream, trailing)
     first = _rows(np.array([t0]), np.array([lat]), np.array([lon]), np.array([hgt]),
                   v0[None, :], (q0 / np.linalg.norm(q0))[None, :])  # as navigate's row 0
@@ -539,7 +546,7 @@ def navigate_log(imu: str | os.PathLike[str], out: str | os.PathLike[str], *, la
             "frame": "NED; q_n_b Hamilton, scalar first; yaw, pitch, roll z-y-x of q_n_b "
                      "(deg); row 0: the initial state at t0 (increments: first stamp - h, "
                      "rates: first stamp); t: end of each update interval",
-            "trailing": trailing, "trailing_samples_dropped": left,
+            "trailing": trailing, "trailing_samples_dropped": left, "gravity": gravity,
             "on_gap": on_gap, "bridged_samples": log.bridged,
             "timing": None if log.timing is None else log.timing.to_dict(),
             "time_base": None if log.timing is None else log.timing.describe(),

@@ -34,7 +34,8 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         "first stamp for rates; then one row per update, t the end of the update. An "
         "increment log whose first two rows are identical (a duplicated first row) warns; "
         "fewer than N samples left after the last whole update are dropped and said so "
-        "(--trailing error refuses them).")
+        "(--trailing error refuses them). Gravity: WGS-84 normal gravity with the second-order "
+        "height correction, or its linear term (--gravity linear).")
     p.set_defaults(handler=run)
     return p
 
@@ -43,6 +44,7 @@ def _arguments(p: argparse.ArgumentParser) -> None:
     from strapdown.algorithms.velocity import NAV_STRUCTURES
     from strapdown.apps.nav import ACC_UNITS, TRAILING_POLICIES
     from strapdown.io.readers import INCREMENT_UNITS, RATE_UNITS
+    from strapdown.truth.earth import GRAVITY_MODELS
 
     g = p.add_argument_group("log")
     g.add_argument("--imu", required=True,
@@ -51,7 +53,8 @@ def _arguments(p: argparse.ArgumentParser) -> None:
     kind.add_argument("--rates", dest="kind", action="store_const", const="rate",
                       default="rate", help="the log holds rates and specific force (default)")
     kind.add_argument("--increments", dest="kind", action="store_const", const="increment",
-                      help="the log holds angular (rad) and velocity (m/s) increments")
+                      help="the log holds angular (rad) and velocity (m/s) increments, each "
+                      "over the interval that ends at its stamp")
     g.add_argument("--units", default=None, choices=(*RATE_UNITS, *INCREMENT_UNITS),
                    help="gyro units (required unless the header declares them, e.g. "
                    "gx[deg/s])")
@@ -94,6 +97,9 @@ def _arguments(p: argparse.ArgumentParser) -> None:
                    "velocity set also holds on a coning body in gravity)")
     a.add_argument("--no-sculling", dest="sculling", action="store_false",
                    help="drop the sculling correction (rotation compensation only)")
+    a.add_argument("--gravity", choices=GRAVITY_MODELS, default="wgs84",
+                   help="normal gravity: the WGS-84 formula (Somigliana with the second-order "
+                   "height correction; default) or its linear height correction (linear)")
     a.add_argument("--trailing", choices=TRAILING_POLICIES, default="drop",
                    help="fewer than N samples left after the last whole conventional update: "
                    "drop them, said on stderr and counted in OUT.meta.json (default: a rate "
@@ -116,7 +122,8 @@ def run(args: argparse.Namespace) -> int:
                        sample_rate_hz=args.sample_rate_hz, subsamples=args.subsamples,
                        structure=args.structure, sculling=args.sculling,
                        accept_unit_warning=args.accept_unit_warning, progress=progress(args),
-                       on_gap=args.on_gap, trailing=args.trailing, **timing_options(args))
+                       on_gap=args.on_gap, trailing=args.trailing, gravity=args.gravity,
+                       **timing_options(args))
     for w in res["warnings"]:
         say(f"warning: {w}")
     if res["trailing_samples_dropped"]:
