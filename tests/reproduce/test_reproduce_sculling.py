@@ -35,7 +35,7 @@ def test_reduced_reproduction(tmp_path, reduced, capsys):
     assert main(["reproduce", "sculling", "--out", str(tmp_path), "--no-progress"]) == 0
     report = (tmp_path / "report.md").read_text()
     for name in ("sculling_law.png", "static.png", "flight.png", "duality.md",
-                 "sculling_realistic.md", "flight_cosine.md"):
+                 "sculling_realistic.md", "flight_cosine.md", "coning_force.md"):
         assert (tmp_path / name).is_file(), name
         assert name in report
     assert "Skipped: smsfusion is not installed" in report
@@ -46,6 +46,9 @@ def test_reduced_reproduction(tmp_path, reduced, capsys):
         for key in ("measured/law Ωh=2π/40", "measured/law Ωh=2π/30"):
             assert abs(float(row[key]) - 1) < 0.01
     assert {row["verdict"] for row in _rows(tmp_path / "duality.csv")} == {"equal"}
+    coning = _rows(tmp_path / "coning_force.csv")
+    assert [row["N"] for row in coning] == ["1", "2"]
+    assert coning[1]["at rest: single chain (m/s²)"].endswith(")")  # measured (law …)
     static = {row["case"]: row for row in _rows(tmp_path / "static.csv")}
     period = next(v for k, v in static.items() if "Schuler period" in k)
     assert abs(float(period["relative"])) < 1e-5
