@@ -10,7 +10,10 @@ and ``smsfusion.StrapdownINS.update``; they are timed on fewer samples and
 reported per sample. The AHRS EKF (every propagation algorithm, with
 accelerometer and magnetometer updates at every output) runs on
 ``ekf_samples`` samples, next to the AHRS peers VQF (offline, C++) and Fusion
-(per-sample Python calls into C) on the same data. Peak resident memory
+(per-sample Python calls into C) on the same data; and the same filter generated as C
+(``export-c --algorithm ahrs``, double and float) compiled with the system C compiler at
+``-O2`` and timed in C beside VQF's C++ (real-time and offline) and Fusion's C, whose
+sources are fetched with pip on first use (:mod:`strapdown.apps.bench_c`). Peak resident memory
 (VmHWM) of a 10⁸-sample stream is measured in a fresh subprocess; about
 140 MB of it is the interpreter with numpy, scipy and numba loaded.
 
@@ -38,10 +41,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["PEER_EXTRA", "run_benchmarks"]
+__all__ = ["COMPILED_MIN", "PEER_EXTRA", "run_benchmarks"]
 
 #: How to install the peers (each skipped peer's record says it).
 PEER_EXTRA = "pip install 'strapdown[bench]'"
+#: Fewest samples for which the compiled AHRS programs are timed by default.
+COMPILED_MIN = 10_000
 
 
 @dataclass(frozen=True)
@@ -284,10 +289,12 @@ def _stream_memory(total, structure, chunk=1 << 16):
 
 def run_benchmarks(samples: int = 10_000_000, peer_samples: int = 20_000, repeat: int = 3,
                    stream_samples: int = 100_000_000, ekf_samples: int = 1_000_000, *,
-                   nav_samples: int = 2_000_000,
+                   nav_samples: int = 2_000_000, compiled_samples: int | None = None,
                    log: Callable[[str], None] | None = None) -> list[dict]:
     """All benchmark records (see the module docstring); ``nav_samples=0`` skips the
-    velocity/sculling benchmarks.
+    velocity/sculling benchmarks. ``compiled_samples``: samples of the compiled AHRS and
+    its compiled peers (default ``ekf_samples``, or none below :data:`COMPILED_MIN`
+    samples, where a compiled program's timing would be mostly its start-up).
 
     ``log`` receives ``[k/total] name`` before each benchmark runs, and one line naming
     the peers that are skipped and why, before the first.
@@ -315,5 +322,21 @@ def run_benchmarks(samples: int = 10_000_000, peer_samples: int = 20_000, repeat
         recs.append(_stream_memory(stream_samples, structure))
     if nav_samples:
         recs.append(_sculling_ratio(recs))
+    if compiled_samples is None:
+        compiled_samples = ekf_samples if ekf_samples >= COMPILED_MIN else 0
+    if compiled_samples:
+        recs += _compiled_ahrs(compiled_samples, repeat, recs[0]["samples_per_s"], say)
+    return recs
+
+
+def _compiled_ahrs(samples: int, repeat: int, floor: float, say) -> list[dict]:
+    """The AHRS compiled from its generated C beside VQF's C++ and Fusion's C
+    (:func:`strapdown.apps.bench_c.c_ahrs_records`), ratios to the NumPy floor."""
+    from strapdown.apps.bench_c import c_ahrs_records
+
+    recs = c_ahrs_records(samples, repeat, _imu, log=say)
+    for r in recs:
+        if r["samples_per_s"] is not None:
+            r["ratio_to_numpy_pass"] = r["samples_per_s"] / floor
     return recs
 

@@ -119,7 +119,8 @@ def _sizes(cfg: AhrsConfig, params: K.Params, prop: dict, mag: bool, n_init: int
     max_off = int(np.max(prop["offsets"])) if len(prop["offsets"]) else 2
     return {"NX": 6 + 3 * (cfg.acc_model == "raw") + 3 * cfg.estimate_acc_bias,
             "INIT_SAMPLES": n_init, "MAG_WINDOW": n_init if mag else 1,
-            "XH": max(max_off + 1, dmax + 2, 3), "DMAX": dmax,
+            # the gyro history: a power of two, so that k % XH is a mask
+            "XH": 1 << (max(max_off + 1, dmax + 2, 3) - 1).bit_length(), "DMAX": dmax,
             "ND": (dmax + stride // 2) // stride + 1 if mag else 1}
 
 
