@@ -29,8 +29,10 @@ def _arguments(p: argparse.ArgumentParser) -> None:
                    help="N, increments (or rate samples) per update")
     p.add_argument("--target", choices=TARGETS, default="coning",
                    help="design target: coning (the highest order of classical-coning drift), "
-                   "polynomial (polynomial-rate conditions, lowest degrees first) or sculling "
-                   "(the highest order of classical-sculling velocity error; increment input)")
+                   "polynomial (polynomial-rate conditions, lowest degrees first), sculling "
+                   "(the highest order of classical-sculling velocity error; increment input) "
+                   "or coning-force (sculling and coning in a constant specific force, order by "
+                   "order; increment input)")
     p.add_argument("--rule", choices=RULES, default="polynomial",
                    help="how to settle coefficients the target leaves free")
     p.add_argument("--previous", type=int, default=None,
@@ -74,6 +76,10 @@ def run(args: argparse.Namespace) -> int:
     if args.target == "sculling":
         lines.append(f"velocity      {_law(d.drift_constant, d.order, 'θ0 A cos ψ')} rectified "
                      "velocity error rate, normal to both vibrations")
+    elif rec["drift_law"].startswith("rectified velocity error rate along the cone axis"):
+        lines.append(f"velocity      {_law(d.drift_constant, d.order, 'a² f')} rectified "
+                     "velocity error rate along the cone axis, coning in a constant force f "
+                     "(the sculling law of the same set: strapdown.design.velocity_error_laws)")
     else:
         lines.append(f"drift         {_law(d.drift_constant, d.order)} about the cone axis")
     if true_drift is not None:
