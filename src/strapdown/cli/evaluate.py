@@ -72,7 +72,8 @@ def sculling_args(p: argparse.ArgumentParser) -> None:
     sc.add_argument("--angle-amplitude-deg", type=float, default=1.0,
                     help="θ0, angular vibration amplitude about body x (deg)")
     sc.add_argument("--accel-amplitude", type=float, default=10.0,
-                    help="A, linear vibration amplitude along body y (m/s²)")
+                    help="A, linear vibration amplitude along body y (m/s²); --motion "
+                    "coning-force: the constant specific force along the cone axis")
     sc.add_argument("--frequency-hz", type=float, default=10.0,
                     help="vibration frequency Ω/2π (Hz)")
     sc.add_argument("--phase-deg", type=float, default=0.0,
@@ -113,17 +114,24 @@ def _vec(v) -> str:
 def _sculling_text(args: argparse.Namespace, res: dict) -> list[str]:
     arith = f"mpmath, {args.precision} digits" if args.precision else "float64"
     ratio = res["velocity_rate_over_law"]
+    axis = "navigation z"
+    motion = (f"sculling: θ0 = {args.angle_amplitude_deg:g}°, A = {args.accel_amplitude:g} "
+              f"m/s², {args.frequency_hz:g} Hz, ψ = {args.phase_deg:g}°")
+    velocity_set = res.get("velocity_set", "rate-input dual")
+    if "force_along_cone_axis_m_s2" in res:  # coning in a constant specific force
+        axis = "cone axis, navigation x"
+        motion = (f"coning in a force: a = {args.half_angle_deg:g}°, {args.cone_rate_hz:g} Hz, "
+                  f"f = {args.accel_amplitude:g} m/s² along the cone axis")
     return [
-        f"motion        sculling: θ0 = {args.angle_amplitude_deg:g}°, A = "
-        f"{args.accel_amplitude:g} m/s², {args.frequency_hz:g} Hz, ψ = {args.phase_deg:g}°",
-        f"algorithm     velocity update, N = {args.subsamples} (coning table3, designer's "
-        "sculling set)",
+        f"motion        {motion}",
+        f"algorithm     velocity update, N = {args.subsamples} (coning table3, velocity set "
+        f"{velocity_set})",
         f"structure     {args.structure} (update period {res['update_period_s']:.6g} s)",
         f"arithmetic    {arith}; {res['samples']} increments",
         f"velocity rate {_vec(res['velocity_error_rate_m_s2'])} m/s² "
         f"({res['velocity_rate_method']}, {res['velocity_rate_points']} points)",
         f"predicted     {_vec(res['predicted_velocity_error_rate_m_s2'])} m/s²",
-        f"measured/law  {'n/a' if ratio is None else f'{ratio:.6f}'} (navigation z)",
+        f"measured/law  {'n/a' if ratio is None else f'{ratio:.6f}'} ({axis})",
         f"max |δv|      {res['max_velocity_error_m_s']:.6e} m/s",
         f"max |δp|      {res['max_position_error_m']:.6e} m",
     ]
