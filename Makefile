@@ -55,11 +55,15 @@ bench: $(STAMP)
 	$(PY) -m pip install --quiet -e ".[bench]"
 	$(PY) benchmarks/run.py --out reports/bench.json
 
-## lint: ruff (style), import-linter (imports only point down the layers), mypy (types)
+## lint: ruff (style), import-linter (imports only point down the layers), mypy (types), and
+## the model's own rules (tools/lint_model.py: no comparison against a registry name — family,
+## structure, coefficient set, motion — outside the model's modules; no function over 80 lines
+## outside the numba kernels)
 lint: $(DEVSTAMP)
 	$(VENV)/bin/ruff check src tests benchmarks
 	$(VENV)/bin/lint-imports
 	$(VENV)/bin/mypy
+	$(PY) tools/lint_model.py src/strapdown
 
 clean:
 	rm -rf $(VENV) build reports .pytest_cache site

@@ -18,9 +18,9 @@ A_SMALL_DEG = math.degrees(1e-9)
 
 
 def _mp_drift(algorithm, structure="conventional", coefficients=None, spp=60, rk4_step="2td"):
-    cfg = EvaluationConfig(algorithm=algorithm, structure=structure, coefficients=coefficients,
-                           half_angle_deg=A_SMALL_DEG, cone_rate_hz=1.0, sample_rate_hz=spp,
-                           duration=2.0, precision=80, rk4_step=rk4_step)
+    cfg = EvaluationConfig.of(algorithm=algorithm, structure=structure, coefficients=coefficients,
+                              half_angle_deg=A_SMALL_DEG, cone_rate_hz=1.0, sample_rate_hz=spp,
+                              duration=2.0, precision=80, rk4_step=rk4_step)
     r = evaluate(cfg)
     return r.cone_axis_drift, r.predicted
 
@@ -61,8 +61,8 @@ def test_sliding_drift_equals_three_period(precision):
     base = dict(algorithm="rate-three", half_angle_deg=1.0, cone_rate_hz=1.0,
                 sample_rate_hz=120.0, duration=6.0 if precision is None else 2.0,
                 precision=precision)
-    conv = evaluate(EvaluationConfig(structure="conventional", **base)).cone_axis_drift
-    sl = evaluate(EvaluationConfig(structure="sliding", **base))
+    conv = evaluate(EvaluationConfig.of(structure="conventional", **base)).cone_axis_drift
+    sl = evaluate(EvaluationConfig.of(structure="sliding", **base))
     assert sl.update_period == pytest.approx(1 / 120)
     assert sl.chain.max() == 2
     assert abs(sl.cone_axis_drift / conv - 1) <= 1e-6
@@ -140,8 +140,8 @@ def test_rate_record_validation(t, w, kw, msg):
 
 def test_evaluate_rate_validation():
     with pytest.raises(ValueError, match="rk4 has no coefficients"):
-        evaluate(EvaluationConfig(algorithm="rk4", coefficients="paper"))
+        evaluate(EvaluationConfig.of(algorithm="rk4", coefficients="paper"))
     with pytest.raises(ValueError, match="supports the structures"):
-        evaluate(EvaluationConfig(algorithm="rate-single", structure="sliding"))
+        evaluate(EvaluationConfig.of(algorithm="rate-single", structure="sliding"))
     with pytest.raises(ValueError, match="takes coefficients"):
-        evaluate(EvaluationConfig(algorithm="rate-three", coefficients="table3"))
+        evaluate(EvaluationConfig.of(algorithm="rate-three", coefficients="table3"))

@@ -27,8 +27,8 @@ def test_coefficients_and_law_are_the_designers():
 
 @pytest.mark.parametrize("spp", [120, 60])
 def test_measured_drift_follows_the_law_in_arbitrary_precision(spp):
-    d = evaluate(EvaluationConfig(algorithm="rate-two", sample_rate_hz=spp, duration=4.0,
-                                  precision=40, half_angle_deg=0.01)).to_dict()
+    d = evaluate(EvaluationConfig.of(algorithm="rate-two", sample_rate_hz=spp, duration=4.0,
+                                     precision=40, half_angle_deg=0.01)).to_dict()
     assert d["cone_axis_drift_rad_s"] / d["predicted_drift_rad_s"] == pytest.approx(1, abs=2e-3)
 
 

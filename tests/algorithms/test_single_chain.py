@@ -38,15 +38,15 @@ def test_single_chain_reaches_conventional_drift(n):
     # same h, small cone angle, arbitrary precision; single chain updates every h
     cfg = dict(motion="coning", half_angle_deg=math.degrees(1e-9), cone_rate_hz=1.0,
                sample_rate_hz=60.0, duration=2.0, subsamples=n, precision=60)
-    sc = evaluate(EvaluationConfig(structure="single-chain", **cfg))
+    sc = evaluate(EvaluationConfig.of(structure="single-chain", **cfg))
     conv = drift_mp(1e-9, 60, n, "conventional", digits=60)
     assert sc.update_period == pytest.approx(1 / 60)
     assert abs(sc.cone_axis_drift / conv - 1) <= 0.02
 
 
 def test_float64_single_chain_at_one_degree():
-    cfg = EvaluationConfig(structure="single-chain", subsamples=2, sample_rate_hz=240.0,
-                           duration=20.0)
+    cfg = EvaluationConfig.of(structure="single-chain", subsamples=2, sample_rate_hz=240.0,
+                              duration=20.0)
     r = evaluate(cfg)
     assert abs(r.cone_axis_drift / r.predicted - 1) <= 0.01
 

@@ -54,7 +54,7 @@ import strapdown
 from strapdown.analysis.evaluate import EvaluationConfig, evaluate
 for alg, st in [("rotvec", "single-chain"), ("rate-single", "conventional"),
                 ("rate-three", "sliding"), ("rk4", "conventional"), ("rotvec", "realtime")]:
-    evaluate(EvaluationConfig(algorithm=alg, structure=st, sample_rate_hz=600, duration=0.1))
+    evaluate(EvaluationConfig.of(algorithm=alg, structure=st, sample_rate_hz=600, duration=0.1))
 from strapdown.ahrs import ekf
 t = np.arange(200) / 100.0
 ekf(t, np.zeros((200, 3)), np.tile([0.0, 0.0, 9.80665], (200, 1)),

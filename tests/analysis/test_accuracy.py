@@ -77,8 +77,8 @@ def test_eq6_as_printed_drifts_much_faster(n):
 
 @pytest.mark.parametrize(("n", "structure"), [(1, "conventional"), (3, "realtime")])
 def test_roundoff_floor_pure_spin_1e7_samples(n, structure):
-    cfg = EvaluationConfig(motion="spin", spin_rate_dps=9000.0, sample_rate_hz=1e4,
-                           duration=1000.0, subsamples=n, structure=structure)
+    cfg = EvaluationConfig.of(motion="spin", spin_rate_dps=9000.0, sample_rate_hz=1e4,
+                              duration=1000.0, subsamples=n, structure=structure)
     res = evaluate(cfg)
     assert res.samples >= 9_999_999
     assert res.drift.method.startswith("whole-periods")
@@ -86,8 +86,8 @@ def test_roundoff_floor_pure_spin_1e7_samples(n, structure):
 
 
 def test_spin_coning_runs_and_has_no_table1_prediction():
-    cfg = EvaluationConfig(motion="spin-coning", spin_rate_dps=1080.0, cone_rate_hz=1.0,
-                           sample_rate_hz=6000.0, duration=2.0, subsamples=3)
+    cfg = EvaluationConfig.of(motion="spin-coning", spin_rate_dps=1080.0, cone_rate_hz=1.0,
+                              sample_rate_hz=6000.0, duration=2.0, subsamples=3)
     d = evaluate(cfg).to_dict()
     assert d["predicted_drift_rad_s"] is None
     assert d["cone_axis_drift_rad_s"] is not None

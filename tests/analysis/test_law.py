@@ -62,7 +62,7 @@ def test_no_ratio_and_gyro_errors():
 
 
 def _law(**kw):
-    return evaluate(EvaluationConfig(**kw)).to_dict()
+    return evaluate(EvaluationConfig.of(**kw)).to_dict()
 
 
 def test_resolved_law_in_float64():
@@ -109,6 +109,6 @@ def test_floor_bounds_the_float64_roundoff(cfg):
 
 
 def test_noisy_gyro_is_flagged():
-    d = evaluate(EvaluationConfig(sample_rate_hz=600.0, duration=4.0, subsamples=2,
-                                  gyro=GyroErrors(white_noise=1e-5), seed=3)).to_dict()
+    d = evaluate(EvaluationConfig.of(sample_rate_hz=600.0, duration=4.0, subsamples=2,
+                                     gyro=GyroErrors(white_noise=1e-5), seed=3)).to_dict()
     assert d["law_status"] == GYRO_ERRORS

@@ -23,7 +23,7 @@ SMALL = dict(motion="sculling", angle_amplitude_deg=1e-12, accel_amplitude=1.0,
 def test_law_against_measurement_in_mpmath(n, structure):
     # Savage (1998b) law −c θ0 A cos ψ (Ωh)^2N, c = N!(N+1)!/(2N+2)!, computed here from its
     # closed form, not from the library's table; measured on the exact increments in 40 digits
-    ev = run_evaluation(EvaluationConfig(subsamples=n, structure=structure, **SMALL))
+    ev = run_evaluation(EvaluationConfig.of(subsamples=n, structure=structure, **SMALL))
     c = math.factorial(n) * math.factorial(n + 1) / math.factorial(2 * n + 2)
     law = -c * math.radians(1e-12) * math.cos(math.radians(20.0)) * (2 * math.pi / 60) ** (2 * n)
     assert float(sculling_law(n).constant) == pytest.approx(c, rel=1e-15)
@@ -36,8 +36,8 @@ def test_law_against_measurement_in_mpmath(n, structure):
 
 def test_float64_agrees_with_mpmath_at_one_degree():
     kw = dict(SMALL, angle_amplitude_deg=1.0, phase_deg=0.0, duration=2.0, subsamples=2)
-    mp = run_evaluation(EvaluationConfig(**kw)).to_dict()["velocity_error_rate_m_s2"]
-    f64 = run_evaluation(EvaluationConfig(**dict(kw, precision=None))).to_dict()
+    mp = run_evaluation(EvaluationConfig.of(**kw)).to_dict()["velocity_error_rate_m_s2"]
+    f64 = run_evaluation(EvaluationConfig.of(**dict(kw, precision=None))).to_dict()
     assert f64["precision_digits"] is None
     assert np.array(f64["velocity_error_rate_m_s2"])[2] == pytest.approx(mp[2], rel=1e-6)
 
@@ -88,16 +88,16 @@ def test_attitude_evaluate_rejects_sculling():
     from strapdown.analysis.evaluate import evaluate
 
     with pytest.raises(InputError, match="run_evaluation"):
-        evaluate(EvaluationConfig(motion="sculling", duration=0.1))
+        evaluate(EvaluationConfig.of(motion="sculling", duration=0.1))
 
 
 @pytest.mark.parametrize(("algorithm", "order", "c"),
                          [("rate-single", 4, 11 / 1440), ("rate-three", 8, 433 / 806400)])
 def test_rate_input_duals_on_the_sculling_motion(algorithm, order, c):
     # the rate-input duals follow the coning law of the same rate algorithm (tables)
-    cfg = EvaluationConfig(motion="sculling", algorithm=algorithm, angle_amplitude_deg=0.01,
-                           accel_amplitude=1.0, frequency_hz=1.0, phase_deg=0.0,
-                           sample_rate_hz=30.0, duration=6.0)
+    cfg = EvaluationConfig.of(motion="sculling", algorithm=algorithm, angle_amplitude_deg=0.01,
+                              accel_amplitude=1.0, frequency_hz=1.0, phase_deg=0.0,
+                              sample_rate_hz=30.0, duration=6.0)
     d = run_evaluation(cfg).to_dict()
     # ψ = 0: at ψ = 20° rate-three measures 0.978× its law here (a sin ψ term of higher order)
     law = -c * math.radians(0.01) * (2 * math.pi / 30) ** order
@@ -105,4 +105,4 @@ def test_rate_input_duals_on_the_sculling_motion(algorithm, order, c):
     assert d["velocity_error_rate_m_s2"][2] / law == pytest.approx(1.0, abs=0.01)
     assert d["coefficients"] == "derived"
     with pytest.raises(InputError, match="float64 only"):
-        run_evaluation(EvaluationConfig(**{**cfg.__dict__, "precision": 30}))
+        run_evaluation(EvaluationConfig.of(**{**cfg.__dict__, "precision": 30}))

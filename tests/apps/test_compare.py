@@ -27,13 +27,13 @@ def test_parse_spec():
 
 
 def test_compare_motion_matches_evaluate(tmp_path):
-    base = EvaluationConfig(half_angle_deg=1.0, cone_rate_hz=2.0, sample_rate_hz=1200.0,
-                            duration=2.0)
+    base = EvaluationConfig.of(half_angle_deg=1.0, cone_rate_hz=2.0, sample_rate_hz=1200.0,
+                               duration=2.0)
     runs = compare_motion(base, ["rotvec:N=2", "rk4"], tmp_path / "cmp")
     for r, alg in zip(runs, [{"subsamples": 2}, {"algorithm": "rk4"}], strict=True):
         import dataclasses
 
-        ev = evaluate(dataclasses.replace(base, **alg))
+        ev = evaluate(dataclasses.replace(base, spec=dataclasses.replace(base.spec, **alg)))
         assert r.summary["max_error_rad"] == float(ev.angle.max())
     assert runs[0].summary["measured_over_law"] == pytest.approx(1.0, abs=2e-3)
     files = sorted(p.name for p in (tmp_path / "cmp").iterdir())

@@ -41,7 +41,7 @@ def _law(n: int, psi_deg: float, theta_deg: float = 1.0) -> float:
 
 
 def test_compare_sculling_rates_follow_the_law(tmp_path):
-    base = EvaluationConfig(motion="sculling", sample_rate_hz=1200.0, duration=1.0)
+    base = EvaluationConfig.of(motion="sculling", sample_rate_hz=1200.0, duration=1.0)
     runs = compare_motion(base, ["rotvec:N=1", "rotvec:N=2:structure=single-chain"],
                           tmp_path / "c")
     assert (tmp_path / "c" / "summary.csv").is_file()
@@ -57,7 +57,7 @@ def test_cli_compare_sculling(tmp_path, capsys):
 
 
 def test_compare_sculling_rejects_attitude_algorithm(tmp_path):
-    base = EvaluationConfig(motion="sculling", sample_rate_hz=1200.0, duration=0.5)
+    base = EvaluationConfig.of(motion="sculling", sample_rate_hz=1200.0, duration=0.5)
     with pytest.raises(InputError, match="velocity algorithms"):
         compare_motion(base, ["rk4"], tmp_path / "c")
 

@@ -144,8 +144,8 @@ def test_accumulated_drift_metric():
 
 
 def test_evaluate_krylov_json():
-    cfg = EvaluationConfig(motion="krylov", krylov_rates=K2, algorithm="miller",
-                           alpha=9 / 20, beta=27 / 40, step=0.1, duration=200.0)
+    cfg = EvaluationConfig.of(motion="krylov", krylov_rates=K2, algorithm="miller",
+                              alpha=9 / 20, beta=27 / 40, step=0.1, duration=200.0)
     d = evaluate(cfg).to_dict()
     assert d["accumulated_drift_rad"] == pytest.approx(PRINTED_T1["miller"], rel=0.005)
     assert d["update_period_s"] == 0.1 and d["alpha"] == 9 / 20
@@ -164,7 +164,7 @@ def test_evaluate_krylov_json():
 )
 def test_bad_configuration(kw, msg):
     with pytest.raises(ValueError, match=msg):
-        evaluate(EvaluationConfig(**kw))
+        evaluate(EvaluationConfig.of(**kw))
 
 
 def test_bad_algorithm_input():

@@ -86,6 +86,9 @@ class Family:
     #: ``min_samples`` sub-interval increments (Plaksiy's algorithms) rather than at a
     #: sample rate.
     stepped: ClassVar[bool] = False
+    #: Whether it runs named N-subsample coning sets (:mod:`.coning`), which a user's
+    #: :class:`~strapdown.algorithms.coning.CoefficientSet` may replace.
+    coning_sets: ClassVar[bool] = False
     #: Default coefficient set (``None``: the family takes no ``coefficients``).
     default_coefficients: ClassVar[ConingSetName | RateCoefficients | None] = None
     #: Full reference of the algorithm (see docs/references.md).
@@ -132,6 +135,25 @@ class Family:
                digits: int) -> MpSolution:
         """Run on a closed-form motion in arbitrary precision."""
         raise ValueError(f"{self.name} runs in float64 only; drop --precision")
+
+    def record(self, spec: AlgorithmSpec) -> dict[str, Any]:
+        """Keys the family adds to an evaluation's record (its coefficients as run)."""
+        return {}
+
+    def candidates(self) -> tuple[AlgorithmSpec, ...]:
+        """The configurations ``strapdown advise`` ranks: by default the family's default
+        in each of its structures (none for a stepped family, whose step is the user's)."""
+        from strapdown.algorithms.spec import AlgorithmSpec
+
+        if self.stepped:
+            return ()
+        name: Any = self.name  # an AlgorithmName once registered
+        return tuple(AlgorithmSpec(name, structure=s) for s in self.structures)
+
+    def amplitude_cubed(self, spec: AlgorithmSpec) -> bool:
+        """Whether the configuration has a drift term of third order in the coning amplitude
+        (which a second-order spectral prediction leaves out; ``advise`` says so)."""
+        return False
 
     def propagation(self, spec: AlgorithmSpec) -> dict[str, Any]:
         """Arguments of the AHRS kernel's propagation step (see :mod:`strapdown.ahrs`)."""

@@ -27,7 +27,7 @@ from strapdown._core.validation import positive, positive_int
 from strapdown.algorithms import _reference
 from strapdown.algorithms.coning import CoefficientSet, WindowedAlgorithm
 from strapdown.algorithms.family import IncrementStructure, Rk4Step
-from strapdown.algorithms.structures import STRUCTURES, startup_sets
+from strapdown.algorithms.structures import UpdateStructure, increment_structure, startup_sets
 from strapdown.truth.motions import Motion
 
 __all__ = ["MAX_MP_SAMPLES", "MpSolution", "run_mp", "run_rk4_mp", "run_windowed_mp"]
@@ -64,18 +64,16 @@ class MpSolution:
     startup: int = 0
 
 
-def _single_chain_phis(theta, coefficients: CoefficientSet):
-    """Single-chain rotation vectors in mpmath, with the same start-up as the float64 path."""
+def _single_chain_phis(theta, coefficients: CoefficientSet, chain):
+    """Single-chain rotation vectors in mpmath, with the same start-up as the float64 path
+    (``chain``: the single-chain structure, which says what the set runs)."""
     from strapdown.algorithms.finite_amplitude import triple_terms
     from strapdown.algorithms.structures import single_chain_coefficients
 
-    if coefficients.name not in ("table3", "none", "finite-amplitude"):
-        raise ValueError("the single chain takes 'table3' (designed optimum), "
-                         "'finite-amplitude' or 'none'")
-    n = coefficients.n if coefficients.name != "none" else 1
+    n = chain.chain_subsamples(coefficients)
     sets = {m: [_mpf(c) for c in single_chain_coefficients(m)] for m in range(1, n + 1)}
     triples = ([(m, i, j, _mpf(c)) for m, i, j, c in triple_terms("single-chain", n)]
-               if coefficients.name == "finite-amplitude" else [])
+               if chain.triple(coefficients) else [])
     zero = mpmath.mpf(0)
     phis = []
     for k in range(len(theta)):
@@ -202,7 +200,7 @@ def run_mp(
     motion: Motion,
     coefficients: CoefficientSet,
     *,
-    structure: IncrementStructure,
+    structure: IncrementStructure | UpdateStructure,
     h: float,
     samples: int,
     digits: int = 50,
@@ -227,8 +225,7 @@ def run_mp(
     t0 : float
         Start time (s).
     """
-    if structure not in STRUCTURES:
-        raise ValueError(f"unknown structure {structure!r}; choose one of {', '.join(STRUCTURES)}")
+    st = increment_structure(structure)  # the registered object answers the facts
     h, samples, digits = _check_run(motion, h, samples, digits)
     n = coefficients.n
     if samples < n:
@@ -236,33 +233,32 @@ def run_mp(
     with mpmath.workdps(digits):
         hm = mpmath.mpf(h)
         tm0 = mpmath.mpf(t0)
-        if structure == "conventional":
-            samples -= samples % n
+        samples = st.usable_samples(samples, n)
         edges = [tm0 + k * hm for k in range(samples + 1)]
         theta = [motion.increment_mp(edges[k], edges[k + 1]) for k in range(samples)]
         q0 = motion.attitude_mp(tm0)
-        if structure == "conventional" and coefficients.triples:
+        if st.whole_updates and coefficients.triples:
             triples = [(m, i, j, _mpf(c)) for m, i, j, c in coefficients.triples]
             q = _reference.conventional_triple(theta, _mp_matrix(coefficients), triples, q0,
                                                MPMATH)
             t_out = edges[::n]
             chain = np.zeros(len(q), int)
-        elif structure == "conventional":
+        elif st.whole_updates:
             q = _reference.conventional(theta, _mp_matrix(coefficients), q0, MPMATH)
             t_out = edges[::n]
             chain = np.zeros(len(q), int)
-        elif structure == "realtime":
-            if coefficients.triples:
-                raise ValueError("the real-time structure runs pair-only sets")
+        elif st.interleaved:
+            st.check_set(coefficients)
             ks = [_mp_matrix(s) for s in startup_sets(coefficients)]
             q = _reference.realtime(theta, ks, q0, MPMATH)
             t_out = edges
             chain = np.arange(len(q)) % n
         else:
-            q = _reference.chain(_single_chain_phis(theta, coefficients), [q0], 1, MPMATH)
+            q = _reference.chain(_single_chain_phis(theta, coefficients, st), [q0], 1,
+                                 MPMATH)
             t_out = edges
             chain = np.zeros(len(q), int)
-            n_sc = n if coefficients.name != "none" else 1
+            n_sc = st.chain_subsamples(coefficients)
             return _errors(motion, q, t_out, chain, digits, min(n_sc - 1, len(q) - 1))
         return _errors(motion, q, t_out, chain, digits)
 

@@ -19,7 +19,7 @@ exponential map. ``exact_exp=True`` uses the exponential map instead (for A3:
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, ClassVar, Literal, get_args
+from typing import TYPE_CHECKING, Any, ClassVar, Literal, get_args
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -32,8 +32,8 @@ from strapdown.algorithms.structures import AttitudeSolution
 if TYPE_CHECKING:
     from strapdown.algorithms.spec import AlgorithmSpec
 
-__all__ = ["ALGORITHMS", "FAMILIES", "STATED", "QuaternionAlgorithm", "quaternion_attitude",
-           "subintervals"]
+__all__ = ["ALGORITHMS", "FAMILIES", "STATED", "QuaternionAlgorithm", "has_beta",
+           "quaternion_attitude", "subintervals"]
 
 #: Plaksiy's quaternion algorithms A1–A3, the families defined here.
 QuaternionAlgorithmName = Literal["miller", "panov", "power"]
@@ -119,6 +119,8 @@ class _QuaternionFamily(Family):
     name: ClassVar[QuaternionAlgorithmName]
     input_kind = "increment"
     stepped = True
+    #: Whether the algorithm has the second coefficient β (Miller's).
+    has_beta: ClassVar[bool] = False
     options = frozenset({"alpha", "beta", "step", "exact_exp"})
     reference = ("Plaksiy (2024): quaternion algorithms A1 (Miller), A2 (Panov), A3 (power) "
                  "on the spherical (Krylov-angle) model")
@@ -136,6 +138,14 @@ class _QuaternionFamily(Family):
         a0, b0 = STATED[self.name]
         return QuaternionAlgorithm(self.name, a0 if spec.alpha is None else spec.alpha,
                                    b0 if spec.beta is None else spec.beta, spec.exact_exp)
+
+    def record(self, spec: AlgorithmSpec) -> dict[str, Any]:
+        """The coefficients as run (stated unless given), ``beta`` where the algorithm has
+        one, the increment map and the step."""
+        a0, b0 = STATED[self.name]
+        return {"alpha": a0 if spec.alpha is None else spec.alpha,
+                "beta": (b0 if spec.beta is None else spec.beta) if self.has_beta else None,
+                "exact_exp": spec.exact_exp, "step_s": spec.step}
 
     def _step(self, spec: AlgorithmSpec) -> float:
         if spec.step is None:
@@ -158,6 +168,7 @@ class Miller(_QuaternionFamily):
     """A1: Miller's three-sample quaternion algorithm (α, β)."""
 
     name = "miller"
+    has_beta = True
 
 
 class Panov(_QuaternionFamily):
@@ -174,3 +185,10 @@ class Power(_QuaternionFamily):
 
 #: The families this module defines, in registry order.
 FAMILIES: tuple[Family, ...] = (Miller(), Panov(), Power())
+_BY_NAME: dict[str, _QuaternionFamily] = {f.name: f for f in (Miller(), Panov(), Power())}
+
+
+def has_beta(name: QuaternionAlgorithmName) -> bool:
+    """Whether algorithm ``name`` has the second coefficient β (Miller's A1)."""
+    subintervals(name)
+    return _BY_NAME[name].has_beta

@@ -379,14 +379,34 @@ class WindowedRateFamily(Family):
             raise ValueError(f"{self.name} needs the sample times t of the rates")
         rec = check_rate_record(t, data, min_samples=self.min_samples(spec))
         w = np.ascontiguousarray(rec.omega)  # validated once, by check_rate_record
-        sliding = spec.structure == "sliding"
+        sliding = spec.update_structure.interleaved
         startup = single_period_algorithm(_coefficients(spec)) if sliding else None
         return _windowed(w, self.windowed(spec), rec.td, float(rec.t[0]), _q0(q0), sliding,
                          startup)
 
+    def min_samples(self, spec: AlgorithmSpec) -> int:
+        """One window: its history, then ``span + 1`` rate samples."""
+        w = self.windowed(spec)
+        return w.history + w.span + 1
+
+    def update_period(self, spec: AlgorithmSpec, h: float) -> float:
+        return spec.update_structure.update_period(self.windowed(spec).update, h)
+
+    def run_mp(self, spec: AlgorithmSpec, motion: Motion, *, h: float, samples: int,
+               digits: int) -> MpSolution:
+        from strapdown.algorithms.precision import run_windowed_mp
+
+        w = self.windowed(spec)
+        if spec.update_structure.interleaved:  # the sliding scheme, started by single-period steps
+            return run_windowed_mp(motion, w, h=h, updates=samples - w.span, digits=digits,
+                                   sliding=True,
+                                   startup=single_period_algorithm(_coefficients(spec)))
+        return run_windowed_mp(motion, w, h=h, updates=(samples - 1 - w.span + w.update)
+                               // w.update, digits=digits)
+
     def propagation(self, spec: AlgorithmSpec) -> dict[str, Any]:
         w = self.windowed(spec)
-        sliding = spec.structure == "sliding"
+        sliding = spec.update_structure.interleaved
         # the sliding scheme starts with single-period steps of the same coefficient set
         start_c = (float(single_period_algorithm(_coefficients(spec))
                          .pair_coefficients[0]) if sliding else 0.0)
@@ -409,21 +429,8 @@ class RateSingle(WindowedRateFamily):
     def windowed(self, spec: AlgorithmSpec) -> WindowedAlgorithm:
         return single_period_algorithm(_coefficients(spec))
 
-    def min_samples(self, spec: AlgorithmSpec) -> int:
-        return 2
-
-    def update_period(self, spec: AlgorithmSpec, h: float) -> float:
-        return h
-
     def drift_law(self, spec: AlgorithmSpec) -> DriftLaw:
         return DriftLaw(*tables.RATE_SINGLE_DRIFT[_coefficients(spec)])
-
-    def run_mp(self, spec: AlgorithmSpec, motion: Motion, *, h: float, samples: int,
-               digits: int) -> MpSolution:
-        from strapdown.algorithms.precision import run_windowed_mp
-
-        return run_windowed_mp(motion, self.windowed(spec), h=h, updates=samples - 1,
-                               digits=digits)
 
 
 class RateThree(WindowedRateFamily):
@@ -437,26 +444,8 @@ class RateThree(WindowedRateFamily):
     def windowed(self, spec: AlgorithmSpec) -> WindowedAlgorithm:
         return three_period_algorithm(_coefficients(spec))
 
-    def min_samples(self, spec: AlgorithmSpec) -> int:
-        return 4
-
-    def update_period(self, spec: AlgorithmSpec, h: float) -> float:
-        return h if spec.structure == "sliding" else 3 * h
-
     def drift_law(self, spec: AlgorithmSpec) -> DriftLaw:
         return DriftLaw(*tables.RATE_THREE_DRIFT[_coefficients(spec)])
-
-    def run_mp(self, spec: AlgorithmSpec, motion: Motion, *, h: float, samples: int,
-               digits: int) -> MpSolution:
-        from strapdown.algorithms.precision import run_windowed_mp
-
-        c = _coefficients(spec)
-        if spec.structure == "sliding":
-            return run_windowed_mp(motion, self.windowed(spec), h=h, updates=samples - 3,
-                                   digits=digits, sliding=True,
-                                   startup=single_period_algorithm(c))
-        return run_windowed_mp(motion, self.windowed(spec), h=h, updates=(samples - 1) // 3,
-                               digits=digits)
 
 
 class Rk4(Family):
@@ -502,7 +491,7 @@ class Rk4(Family):
         return run_rk4_mp(motion, h=h, samples=samples, step=spec.rk4_step, digits=digits)
 
     def propagation(self, spec: AlgorithmSpec) -> dict[str, Any]:
-        if spec.rk4_step != "2td" or spec.structure != "conventional":
+        if spec.rk4_step != "2td" or spec.update_structure.every_sample:
             raise ValueError("the filter's rk4 is the 2td step, conventional structure")
         i0, f0 = np.zeros(0, np.int64), np.zeros(0)
         return dict(is_rate=True, offsets=i0, weights=f0, pi=i0, pj=i0, pc=f0, stride=2,
@@ -535,21 +524,8 @@ class RateTwo(WindowedRateFamily):
         return WindowedAlgorithm("rate", 2, (0, 1, 2), self._WEIGHTS, self._PAIRS,
                                  self._SETS[c], f"rate-two ({c})")
 
-    def min_samples(self, spec: AlgorithmSpec) -> int:
-        return 3
-
-    def update_period(self, spec: AlgorithmSpec, h: float) -> float:
-        return 2 * h
-
     def drift_law(self, spec: AlgorithmSpec) -> DriftLaw:
         return DriftLaw(*self._DRIFT[_coefficients(spec)])
-
-    def run_mp(self, spec: AlgorithmSpec, motion: Motion, *, h: float, samples: int,
-               digits: int) -> MpSolution:
-        from strapdown.algorithms.precision import run_windowed_mp
-
-        return run_windowed_mp(motion, self.windowed(spec), h=h, updates=(samples - 1) // 2,
-                               digits=digits)
 
 
 #: The families this module defines, in registry order.

@@ -18,6 +18,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any, ClassVar, Literal
 
 from strapdown.algorithms.coning import (
+    MAX_SUBSAMPLES,
     CoefficientSet,
     ConingSetName,
     coefficient_set,
@@ -26,7 +27,7 @@ from strapdown.algorithms.coning import (
     table1_drift_constant,
 )
 from strapdown.algorithms.family import DriftLaw, Family, IncrementStructure
-from strapdown.algorithms.structures import AttitudeSolution, increment_structure, run_structure
+from strapdown.algorithms.structures import AttitudeSolution, increment_structure, structure
 
 if TYPE_CHECKING:
     from numpy.typing import ArrayLike
@@ -50,6 +51,7 @@ class Rotvec(Family):
                                                            "single-chain")
     options = frozenset({"subsamples"})
     default_coefficients = "table3"
+    coning_sets = True
     reference = ("Li & Zhang 2017, J. Control Sci. Eng. 9542423: eq. 6 (pair form), eq. 9 "
                  "(rotation vector), eq. 10 (conventional), eq. 15 (real-time); single chain: "
                  "strapdown designer (c_m = (K_m - (N-m)/2)/N)")
@@ -59,20 +61,21 @@ class Rotvec(Family):
 
     def check(self, spec: AlgorithmSpec) -> None:
         super().check(spec)
-        self.coefficient_set(spec)  # unknown sets and impossible N fail here
-        if spec.resolved_coefficients == "finite-amplitude" and spec.structure == "realtime":
-            raise ValueError("coefficients finite-amplitude run in the conventional and "
-                             "single-chain structures, not realtime")
+        cs = self.coefficient_set(spec)  # unknown sets and impossible N fail here
+        if cs.triples and spec.update_structure.pair_only:
+            able = " and ".join(s for s in self.structures if not structure(s).pair_only)
+            raise ValueError(f"coefficients {cs.name} run in the {able} structures, not "
+                             f"{spec.structure}")
 
     def coefficient_set(self, spec: AlgorithmSpec) -> CoefficientSet:
         """The configured coefficient set (what the C exporter and the filter need)."""
         return coefficient_set(coning_set_name(spec.resolved_coefficients), spec.subsamples)
 
     def min_samples(self, spec: AlgorithmSpec) -> int:
-        return 1 if spec.structure == "single-chain" else spec.subsamples
+        return spec.update_structure.min_increments(spec.subsamples)
 
     def update_period(self, spec: AlgorithmSpec, h: float) -> float:
-        return spec.subsamples * h if spec.structure == "conventional" else h
+        return spec.update_structure.update_period(spec.subsamples, h)
 
     def drift_law(self, spec: AlgorithmSpec) -> DriftLaw | None:
         cs = self.coefficient_set(spec)
@@ -82,8 +85,8 @@ class Rotvec(Family):
 
     def run(self, spec: AlgorithmSpec, data: ArrayLike, *, h: float, t: ArrayLike | None = None,
             t0: float = 0.0, q0: ArrayLike | None = None) -> AttitudeSolution:
-        return run_structure(increment_structure(spec.structure), data,
-                             self.coefficient_set(spec), h=h, t0=t0, q0=q0)
+        return increment_structure(spec.structure).run(data, self.coefficient_set(spec), h=h,
+                                                       t0=t0, q0=q0)
 
     def run_mp(self, spec: AlgorithmSpec, motion: Motion, *, h: float, samples: int,
                digits: int) -> MpSolution:
@@ -93,10 +96,30 @@ class Rotvec(Family):
                       structure=increment_structure(spec.structure), h=h, samples=samples,
                       digits=digits)
 
+    def candidates(self) -> tuple[AlgorithmSpec, ...]:
+        """Every N in every structure with the default set, then the finite-amplitude sets
+        (N ≥ 2) in the structures that run triple terms."""
+        from strapdown.algorithms.spec import AlgorithmSpec
+
+        name: Any = self.name
+        out = [AlgorithmSpec(name, subsamples=n, structure=s)
+               for n in range(1, MAX_SUBSAMPLES + 1) for s in self.structures]
+        triple = [s for s in self.structures if not structure(s).pair_only]
+        out += [AlgorithmSpec(name, subsamples=n, structure=s,
+                              coefficients="finite-amplitude")
+                for n in range(2, MAX_SUBSAMPLES + 1) for s in triple]
+        return tuple(out)
+
+    def amplitude_cubed(self, spec: AlgorithmSpec) -> bool:
+        """The default (Table 3) sets at N ≥ 4 outside the single chain (reproduce
+        high-order)."""
+        return (spec.subsamples >= 4 and spec.coefficients is None
+                and not spec.update_structure.own_startup)
+
     def propagation(self, spec: AlgorithmSpec) -> dict[str, Any]:
         import numpy as np
 
-        if spec.structure != "conventional":
+        if not spec.update_structure.whole_updates:  # the filter steps once per whole update
             raise ValueError("the filter runs rotvec in the conventional structure")
         if self.coefficient_set(spec).triples:
             raise ValueError("the filter runs pair-only coefficient sets, not "

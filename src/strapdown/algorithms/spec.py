@@ -37,7 +37,8 @@ from strapdown.algorithms.family import (
 from strapdown.algorithms.quaternion import QuaternionAlgorithmName
 from strapdown.algorithms.rate import RateAlgorithmName
 from strapdown.algorithms.rotvec import RotvecName
-from strapdown.algorithms.structures import AttitudeSolution
+from strapdown.algorithms.structures import AttitudeSolution, UpdateStructure
+from strapdown.algorithms.structures import structure as structure_object
 
 if TYPE_CHECKING:
     from numpy.typing import ArrayLike
@@ -57,6 +58,7 @@ __all__ = [
     "algorithms_taking",
     "family",
     "parse_spec",
+    "register",
 ]
 
 #: A coefficient set some family takes: a named coning set or a rate-algorithm set.
@@ -85,6 +87,32 @@ _ALIASES = {"N": "subsamples", "n": "subsamples"}
 _INT = {"subsamples"}
 _FLOAT = {"alpha", "beta", "step"}
 _BOOL = {"exact_exp"}
+
+
+def register(fam: Family) -> Family:
+    """Add an algorithm family to the registry: everything that lists, parses, runs,
+    evaluates, compares, sweeps, advises, propagates or exports families sees it from here
+    on (a plug-in; the shipped families are registered on import).
+
+    The family must name itself, its input kind and registered structures, and its name
+    must be new; ValueError otherwise.
+    """
+    global ALGORITHMS, STRUCTURES
+    if not isinstance(fam, Family):
+        raise ValueError(f"a family must be a Family instance, got {type(fam).__name__}")
+    name = getattr(fam, "name", None)
+    if not isinstance(name, str) or not name or ":" in name or "=" in name:
+        raise ValueError(f"a family needs a name without ':' or '=', got {name!r}")
+    if name in REGISTRY:
+        raise ValueError(f"a family named {name!r} is already registered")
+    if getattr(fam, "input_kind", None) not in ("increment", "rate"):
+        raise ValueError(f"family {name!r}: input_kind must be 'increment' or 'rate'")
+    for s in fam.structures:
+        structure_object(s)  # unknown structures fail here, listing the registered ones
+    REGISTRY[cast("AlgorithmName", name)] = fam
+    ALGORITHMS = tuple(REGISTRY)
+    STRUCTURES = tuple(dict.fromkeys(s for f in REGISTRY.values() for s in f.structures))
+    return fam
 
 
 def family(name: AlgorithmName) -> Family:
@@ -116,7 +144,8 @@ class AlgorithmSpec:
         ``derived`` for the rate algorithms; ``rk4`` and the quaternion algorithms have
         none).
     structure : StructureName
-        Update structure, one the family runs in.
+        Update structure, one the family runs in (given by name; held as the registered
+        :class:`~strapdown.algorithms.structures.UpdateStructure`, which is also its name).
     rk4_step : {"2td", "td-interp"}
         RK4 step variant (``rk4`` only).
     alpha, beta : float, optional
@@ -130,7 +159,7 @@ class AlgorithmSpec:
     algorithm: AlgorithmName = "rotvec"
     subsamples: int = 3
     coefficients: CoefficientName | None = None
-    structure: StructureName = "conventional"
+    structure: StructureName | UpdateStructure = "conventional"
     rk4_step: Rk4Step = "2td"
     alpha: float | None = None
     beta: float | None = None
@@ -145,6 +174,8 @@ class AlgorithmSpec:
         if self.structure not in fam.structures:
             raise ValueError(f"{self.algorithm} supports the structures "
                              f"{', '.join(fam.structures)}, not {self.structure!r}")
+        # the registered object, which answers the structure's facts (and is its name)
+        object.__setattr__(self, "structure", structure_object(self.structure))
         if self.step is not None:
             positive(self.step, "step")
         fam.check(self)
@@ -176,6 +207,12 @@ class AlgorithmSpec:
     def family(self) -> Family:
         """The registered family this spec configures."""
         return REGISTRY[self.algorithm]
+
+    @property
+    def update_structure(self) -> UpdateStructure:
+        """The registered update structure (the object ``structure`` holds, typed as such):
+        ask it for the structure's facts (update period, chains, start-up …)."""
+        return cast(UpdateStructure, self.structure)
 
     @property
     def input_kind(self) -> InputKind:

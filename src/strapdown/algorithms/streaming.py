@@ -28,10 +28,11 @@ from strapdown.algorithms.family import IncrementStructure
 from strapdown.algorithms.finite_amplitude import triple_terms
 from strapdown.algorithms.rate import Rk4, WindowedRateFamily, single_period_algorithm
 from strapdown.algorithms.structures import (
-    STRUCTURES,
     AttitudeSolution,
+    UpdateStructure,
     _run_windowed,
     _unit_q0,
+    increment_structure,
     single_chain_coefficients,
     single_chain_table,
     stack_sets,
@@ -70,32 +71,26 @@ class RotvecStream:
     first N − 1 start-up outputs until N increments have arrived.
     """
 
-    def __init__(self, structure: IncrementStructure, coefficients: CoefficientSet, *, h: float,
-                 t0: float = 0.0, q0: ArrayLike | None = None) -> None:
-        if structure not in STRUCTURES:
-            raise ValueError(f"unknown structure {structure!r}; choose conventional, realtime "
-                             "or single-chain")
+    def __init__(self, structure: IncrementStructure | UpdateStructure,
+                 coefficients: CoefficientSet, *, h: float, t0: float = 0.0,
+                 q0: ArrayLike | None = None) -> None:
+        st = increment_structure(structure)  # the registered object: it answers the facts
         if not isinstance(coefficients, CoefficientSet):
             raise ValueError("coefficients must be a CoefficientSet")
-        if coefficients.triples and structure == "realtime":
-            raise ValueError(f"the real-time structure runs pair-only sets; "
-                             f"{coefficients.name!r} has triple cross products")
-        self.structure = structure
+        st.check_set(coefficients)
+        self.structure = st
         self.coefficients = coefficients
         self.h = positive(h, "h (sample interval)")
         self.t0 = float(finite_array(t0, "t0"))
         self._q0 = _unit_q0(q0)
         self.n = coefficients.n
         self._triple = triple_arrays(coefficients.triples)
-        if structure == "single-chain":
-            if coefficients.name not in ("table3", "none", "finite-amplitude"):
-                raise ValueError("the single chain takes 'table3' (designed optimum), "
-                                 "'finite-amplitude' or 'none'")
-            self._table = single_chain_table(self.n if coefficients.name != "none" else 1)
-            if coefficients.name == "finite-amplitude":  # the single chain's own triple set
+        if st.own_startup:  # the single chain: its own table
+            self._table = single_chain_table(st.chain_subsamples(coefficients))
+            if st.triple(coefficients):  # the single chain's own triple set
                 self._triple = triple_arrays(triple_terms("single-chain", self.n))
                 self._steady = np.array([float(c) for c in single_chain_coefficients(self.n)])
-        if structure == "realtime":
+        if st.interleaved:
             self._ks = stack_sets(startup_sets(coefficients))
         self._buf = _EMPTY  # increments carried over
         self._qhist: NDArray[np.float64] | None = None  # last attitude(s)
@@ -105,7 +100,7 @@ class RotvecStream:
     @property
     def samples(self) -> int:
         """Increments fed so far."""
-        return self._count + self._buf.shape[0] if self.structure == "conventional" else (
+        return self._count + self._buf.shape[0] if self.structure.whole_updates else (
             self._count)
 
     def feed(self, increments: ArrayLike) -> AttitudeSolution:
@@ -230,7 +225,7 @@ class RateStream:
         self.td = positive(td, "td (sample period)")
         self.t0 = float(finite_array(t0, "t0"))
         self._q0 = _unit_q0(q0)
-        self._sliding = spec.structure == "sliding"
+        self._sliding = spec.update_structure.interleaved
         self._rk4 = isinstance(fam, Rk4)
         if self._rk4:
             self._mode = 0 if spec.rk4_step == "2td" else 1

@@ -24,7 +24,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 from fractions import Fraction
-from typing import TYPE_CHECKING, Literal, cast, get_args
+from typing import TYPE_CHECKING, ClassVar, Literal, cast, get_args
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -44,7 +44,7 @@ from strapdown.algorithms.coning import (
     coning_set_name,
     triple_arrays,
 )
-from strapdown.algorithms.family import IncrementStructure
+from strapdown.algorithms.family import IncrementStructure, StructureName
 from strapdown.algorithms.finite_amplitude import triple_terms
 
 if TYPE_CHECKING:  # the records the structures take, as AlgorithmSpec.run does
@@ -53,22 +53,203 @@ if TYPE_CHECKING:  # the records the structures take, as AlgorithmSpec.run does
 
 __all__ = [
     "STRUCTURES",
+    "STRUCTURE_REGISTRY",
     "AttitudeSolution",
     "IncrementStructure",
     "TailPolicy",
+    "UpdateStructure",
     "chain_rotation_vectors",
     "conventional",
     "increment_structure",
     "realtime",
+    "register_structure",
     "run_structure",
     "single_chain",
+    "structure",
     "windowed",
 ]
 
-#: The update structures of increment input, in the order the command line lists them.
-STRUCTURES: tuple[IncrementStructure, ...] = get_args(IncrementStructure)
 #: What :func:`conventional` does with increments that do not fill a last update.
 TailPolicy = Literal["error", "drop"]
+
+
+class UpdateStructure(str):
+    """An update structure: a registered object that answers its own facts.
+
+    It is also its name (a ``str`` subclass): it compares, hashes, prints and serialises as
+    ``"conventional"``, ``"realtime"`` … so spec strings, JSON records and file names are
+    unchanged, while the library asks it — not its name — what it does. ``update`` below is
+    the samples one update of the algorithm spans (N for the rotation vector, the window's
+    update for a windowed rate algorithm).
+
+    Attributes
+    ----------
+    every_sample : bool
+        An output every input sample (else one per update).
+    interleaved : bool
+        Its outputs come from ``update`` interleaved chains that never exchange information
+        (the real-time and sliding structures), else from one chain.
+    whole_updates : bool
+        It consumes increments in whole updates (a tail shorter than one is dropped or
+        refused).
+    own_startup : bool
+        It starts from the first increment with fewer-sample sets of its own (the single
+        chain), so one increment gives an output.
+    pair_only : bool
+        It runs pair-only coefficient sets (no triple cross products).
+    runs_increments : bool
+        It chains N-subsample coefficient sets on increments (:meth:`run`); the sliding
+        structure belongs to the windowed rate algorithms instead.
+    description : str
+        One line for help texts.
+    """
+
+    every_sample: bool = False
+    interleaved: bool = False
+    whole_updates: bool = False
+    own_startup: bool = False
+    pair_only: bool = False
+    runs_increments: bool = True
+    description: str = ""
+
+    def __new__(cls, name: str) -> UpdateStructure:
+        return super().__new__(cls, name)
+
+    def __reduce__(self) -> tuple[object, tuple[str]]:  # unpickles to the registered object
+        return (structure, (str(self),))
+
+    @property
+    def name(self) -> str:
+        """The registry name (the plain string)."""
+        return str(self)
+
+    def update_period(self, update: int, h: float) -> float:
+        """Time between outputs for updates of ``update`` samples every ``h`` seconds."""
+        return h if self.every_sample else update * h
+
+    def chains(self, update: int) -> int:
+        """Interleaved chains behind the outputs."""
+        return update if self.interleaved else 1
+
+    def min_increments(self, n: int) -> int:
+        """Fewest increments that give one output with an N-subsample set."""
+        return 1 if self.own_startup else n
+
+    def usable_samples(self, samples: int, update: int) -> int:
+        """The samples of a run of ``samples`` that it uses (whole updates when it needs
+        them)."""
+        return samples - samples % update if self.whole_updates else samples
+
+    def check_set(self, coefficients: CoefficientSet) -> None:
+        """Whether it runs ``coefficients`` (ValueError naming why not)."""
+        if self.pair_only and coefficients.triples:
+            raise ValueError(f"the {self} structure runs pair-only sets; {coefficients.name!r} "
+                             "has triple cross products")
+
+    def chain_subsamples(self, coefficients: CoefficientSet) -> int:
+        """The N of the coefficients a chain runs for ``coefficients`` (their own N)."""
+        self.check_set(coefficients)
+        return coefficients.n
+
+    def triple(self, coefficients: CoefficientSet) -> bool:
+        """Whether ``coefficients`` run with triple cross products here."""
+        self.check_set(coefficients)
+        return bool(coefficients.triples)
+
+    def run(self, increments: ArrayLike | GyroRecord | ImuLog, coefficients: CoefficientSet,
+            *, h: float | None = None, t0: float | None = None, q0: ArrayLike | None = None
+            ) -> AttitudeSolution:
+        """Run ``coefficients`` on increments (an array with ``h``, or a record)."""
+        raise ValueError(f"the {self} structure does not run coefficient sets on increments")
+
+
+class _Conventional(UpdateStructure):
+    whole_updates = True
+    description = "an update every N samples (T = N h)"
+
+    def run(self, increments, coefficients, *, h=None, t0=None, q0=None):
+        return conventional(increments, coefficients, h=h, t0=t0, q0=q0, tail="drop")
+
+
+class _Realtime(UpdateStructure):
+    every_sample = True
+    interleaved = True
+    pair_only = True
+    description = "Li & Zhang's real-time structure: an output every h from N chains"
+
+    def run(self, increments, coefficients, *, h=None, t0=None, q0=None):
+        return realtime(increments, coefficients, h=h, t0=t0, q0=q0)
+
+
+class _SingleChain(UpdateStructure):
+    every_sample = True
+    own_startup = True
+    description = "the designer's single chain: an output every h with N-subsample accuracy"
+    #: The sets it takes (the designer's), with the subsamples and triple terms each runs.
+    _SETS: ClassVar[dict[str, tuple[bool, bool]]] = {  # name: (plain sum, triple terms)
+        "table3": (False, False), "none": (True, False), "finite-amplitude": (False, True)}
+
+    def check_set(self, coefficients: CoefficientSet) -> None:
+        if coefficients.name not in self._SETS:
+            raise ValueError(
+                "the single chain takes its coefficients from the designer: use "
+                "'table3' (the classical-coning optimum), 'finite-amplitude' or 'none', not "
+                f"{coefficients.name!r}"
+            )
+
+    def chain_subsamples(self, coefficients: CoefficientSet) -> int:
+        """The N of the chain's own coefficients (1 for the plain sum ``none``)."""
+        self.check_set(coefficients)
+        return 1 if self._SETS[coefficients.name][0] else coefficients.n
+
+    def triple(self, coefficients: CoefficientSet) -> bool:
+        """Whether the chain adds its own triple terms (the finite-amplitude set)."""
+        self.check_set(coefficients)
+        return self._SETS[coefficients.name][1]
+
+    def run(self, increments, coefficients, *, h=None, t0=None, q0=None):
+        return single_chain(increments, self.chain_subsamples(coefficients), h=h, t0=t0,
+                            q0=q0, triple=self.triple(coefficients))
+
+
+class _Sliding(UpdateStructure):
+    every_sample = True
+    interleaved = True
+    runs_increments = False
+    description = "Wang et al.'s sliding scheme: an output every td from the window's chains"
+
+
+#: Every registered update structure by name, in the order the command line lists them.
+STRUCTURE_REGISTRY: dict[str, UpdateStructure] = {
+    s: s for s in (_Conventional("conventional"), _Realtime("realtime"),
+                   _SingleChain("single-chain"), _Sliding("sliding"))}
+if tuple(STRUCTURE_REGISTRY) != get_args(StructureName):  # one list of names: the Literal
+    raise RuntimeError(f"the structures {tuple(STRUCTURE_REGISTRY)} and StructureName "
+                       f"{get_args(StructureName)} disagree")
+#: The update structures of increment input, in the order the command line lists them.
+STRUCTURES: tuple[UpdateStructure, ...] = tuple(
+    s for s in STRUCTURE_REGISTRY.values() if s.runs_increments)
+
+
+def structure(name: object) -> UpdateStructure:
+    """The registered update structure ``name`` (ValueError listing them)."""
+    found = STRUCTURE_REGISTRY.get(name) if isinstance(name, str) else None
+    if found is None:
+        raise ValueError(f"unknown structure {name!r}; choose one of "
+                         f"{', '.join(STRUCTURE_REGISTRY)}")
+    return found
+
+
+def register_structure(obj: UpdateStructure) -> UpdateStructure:
+    """Add an update structure to the registry (its name must be new)."""
+    if not isinstance(obj, UpdateStructure):
+        raise ValueError(f"a structure must be an UpdateStructure, got {type(obj).__name__}")
+    if obj in STRUCTURE_REGISTRY:
+        raise ValueError(f"a structure named {obj.name!r} is already registered")
+    STRUCTURE_REGISTRY[obj.name] = obj
+    global STRUCTURES
+    STRUCTURES = tuple(s for s in STRUCTURE_REGISTRY.values() if s.runs_increments)
+    return obj
 
 
 @dataclass(frozen=True)
@@ -252,36 +433,25 @@ def realtime(
     return AttitudeSolution(t0 + k * h, q, "realtime", coefficients, h, h, k % n)
 
 
-def increment_structure(name: object) -> IncrementStructure:
-    """``name`` if it is an increment update structure, else ValueError listing them."""
-    if name not in STRUCTURES:
+def increment_structure(name: object) -> UpdateStructure:
+    """The registered structure ``name`` if it runs increments, else ValueError listing
+    them."""
+    found = STRUCTURE_REGISTRY.get(name) if isinstance(name, str) else None
+    if found is None or not found.runs_increments:
         raise ValueError(f"unknown structure {name!r}; choose one of {', '.join(STRUCTURES)}")
-    return name
+    return found
 
 
-def run_structure(name: IncrementStructure, increments: ArrayLike | GyroRecord | ImuLog,
+def run_structure(name: IncrementStructure | UpdateStructure,
+                  increments: ArrayLike | GyroRecord | ImuLog,
                   coefficients: CoefficientSet, *, h: float | None = None,
                   t0: float | None = None, q0: ArrayLike | None = None) -> AttitudeSolution:
-    """Dispatch by structure name (``"conventional"``, ``"realtime"`` or ``"single-chain"``).
+    """Run ``coefficients`` in the increment structure ``name`` (:meth:`UpdateStructure.run`).
 
     The conventional structure drops a tail of fewer than N increments here
     (``tail="drop"``); call :func:`conventional` directly to have it refused.
     """
-    if name == "conventional":
-        return conventional(increments, coefficients, h=h, t0=t0, q0=q0, tail="drop")
-    if name == "realtime":
-        return realtime(increments, coefficients, h=h, t0=t0, q0=q0)
-    if name == "single-chain":
-        if coefficients.name not in ("table3", "none", "finite-amplitude"):
-            raise ValueError(
-                "the single chain takes its coefficients from the designer: use "
-                "'table3' (the classical-coning optimum), 'finite-amplitude' or 'none', not "
-                f"{coefficients.name!r}"
-            )
-        n = coefficients.n if coefficients.name != "none" else 1
-        return single_chain(increments, n, h=h, t0=t0, q0=q0,
-                            triple=coefficients.name == "finite-amplitude")
-    raise ValueError(f"unknown structure {name!r}; choose one of {', '.join(STRUCTURES)}")
+    return increment_structure(name).run(increments, coefficients, h=h, t0=t0, q0=q0)
 
 
 def windowed(samples: ArrayLike, algorithm: WindowedAlgorithm, *, h: float, t0: float = 0.0,

@@ -24,6 +24,7 @@ from strapdown._core.validation import (
 )
 from strapdown.algorithms.coning import table1_drift_constant
 from strapdown.algorithms.family import IncrementStructure
+from strapdown.algorithms.structures import increment_structure
 from strapdown.rotation.error import attitude_error_angle, attitude_error_vector
 from strapdown.rotation.quaternion import quat_conjugate, quat_multiply
 from strapdown.truth.motions import Motion
@@ -209,14 +210,12 @@ def table1_prediction(half_angle: float, cone_rate: float, h: float, n: int) -> 
 
 
 def update_period(structure: IncrementStructure, n: int, h: float) -> float:
-    """Time between attitude outputs: ``N h`` (conventional) or ``h`` (real-time)."""
+    """Time between attitude outputs of an N-subsample increment structure: ``N h``
+    (conventional) or ``h`` (real-time, single chain) — the structure's own answer
+    (:meth:`~strapdown.algorithms.structures.UpdateStructure.update_period`)."""
     n = positive_int(n, "N")
     h = positive(h, "h")
-    if structure == "conventional":
-        return n * h
-    if structure in ("realtime", "single-chain"):
-        return h
-    raise ValueError(f"unknown structure {structure!r}")
+    return increment_structure(structure).update_period(n, h)
 
 
 def rotation_per_update(rate: float, structure: IncrementStructure, n: int, h: float) -> float:

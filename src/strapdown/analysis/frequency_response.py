@@ -38,7 +38,7 @@ from strapdown.algorithms import _reference
 from strapdown.algorithms.coning import WindowedAlgorithm
 from strapdown.algorithms.errata import TABLE7
 from strapdown.algorithms.finite_amplitude import triple_terms
-from strapdown.algorithms.rate import WindowedRateFamily
+from strapdown.algorithms.rate import Rk4, WindowedRateFamily
 from strapdown.algorithms.spec import AlgorithmSpec
 from strapdown.algorithms.structures import single_chain_coefficients
 from strapdown.truth.motions import ClassicalConing, SpinConing
@@ -73,11 +73,12 @@ def _from_windowed(alg: WindowedAlgorithm, triples=()) -> UpdateWindow:
 
 def _rotvec_window(spec: AlgorithmSpec) -> UpdateWindow:
     cs = spec.family.coefficient_set(spec)  # type: ignore[attr-defined]
-    if spec.structure == "single-chain":
-        n = cs.n if cs.name != "none" else 1
+    st = spec.update_structure
+    if st.own_startup:  # the single chain: its own coefficients, one increment per update
+        n = st.chain_subsamples(cs)
         c = single_chain_coefficients(n)
         pairs = tuple((n - 1 - m, n - 1, v) for m, v in enumerate(c, start=1))
-        tri = triple_terms("single-chain", n) if cs.name == "finite-amplitude" else ()
+        tri = triple_terms("single-chain", n) if st.triple(cs) else ()
         return UpdateWindow("increment", 1, tuple(range(-(n - 1), 1)),
                             (Fraction(0),) * (n - 1) + (Fraction(1),), pairs, tri)
     n = cs.n
@@ -100,12 +101,12 @@ def update_window(algorithm: AlgorithmSpec | WindowedAlgorithm | UpdateWindow,
     if not isinstance(algorithm, AlgorithmSpec):
         raise ValueError("algorithm must be an AlgorithmSpec, a WindowedAlgorithm or an "
                          f"UpdateWindow, got {type(algorithm).__name__}")
-    if algorithm.algorithm == "rotvec":
+    fam = algorithm.family
+    if fam.coning_sets:
         return _rotvec_window(algorithm)
-    if algorithm.algorithm == "rk4":
+    if isinstance(fam, Rk4):
         step = algorithm.rk4_step
         return UpdateWindow("rate", 2 if step == "2td" else 1, (), (), (), (), step)
-    fam = algorithm.family
     if isinstance(fam, WindowedRateFamily):
         return _from_windowed(fam.windowed(algorithm))
     raise ValueError(f"no exact classical-coning response for {algorithm}: it is not a "

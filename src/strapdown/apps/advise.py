@@ -4,9 +4,10 @@ The environment is the cross-spectrum of the body rates — estimated from a gyr
 Welch's method, or read from a file — and the drift each candidate algorithm would have
 there is predicted by summing its exact classical-coning response over the coning
 (quadrature) spectrum (:mod:`strapdown.analysis.spectrum`; pseudo-coning in the sense of
-Ignagni (1996)). The candidates are every registered structure and N of the rotation
-vector, the finite-amplitude sets, and the windowed rate families and RK4 (those of the
-log's input kind). Costs (operations per second) come from the caller — the command line
+Ignagni (1996)). The candidates are every registered family's own
+(:meth:`~strapdown.algorithms.family.Family.candidates`: every structure and N of the
+rotation vector and its finite-amplitude sets, each rate family in its structures), those
+of the log's input kind. Costs (operations per second) come from the caller — the command line
 counts them in the C the exporter generates (:mod:`strapdown.codegen.export_c`). The
 recommendation is the cheapest candidate within the drift budget (and ``max_ops``); with
 no coning content in the log, the cheapest candidate.
@@ -25,11 +26,8 @@ from numpy.typing import NDArray
 
 from strapdown._core.errors import InputError, shown
 from strapdown._core.validation import positive
-from strapdown.algorithms.coning import MAX_SUBSAMPLES
 from strapdown.algorithms.family import InputKind
-from strapdown.algorithms.finite_amplitude import TRIPLE
-from strapdown.algorithms.spec import AlgorithmSpec
-from strapdown.algorithms.structures import STRUCTURES
+from strapdown.algorithms.spec import REGISTRY, AlgorithmSpec
 from strapdown.analysis.accuracy import drift_rate
 from strapdown.analysis.spectrum import (
     PAIRS,
@@ -213,21 +211,12 @@ class Advice:
 
 
 def candidate_specs(kind: InputKind | None) -> list[AlgorithmSpec]:
-    """The candidates for a log of ``kind`` (None: both kinds)."""
-    out: list[AlgorithmSpec] = []
-    if kind in (None, "increment"):
-        for n in range(1, MAX_SUBSAMPLES + 1):
-            for structure in STRUCTURES:
-                out.append(AlgorithmSpec("rotvec", subsamples=n, structure=structure))
-        for n in range(2, MAX_SUBSAMPLES + 1):
-            for triple in TRIPLE:
-                out.append(AlgorithmSpec("rotvec", subsamples=n, structure=triple,
-                                         coefficients="finite-amplitude"))
-    if kind in (None, "rate"):
-        for text in ("rate-single", "rate-two", "rate-three", "rate-three:structure=sliding",
-                     "rk4"):
-            out.append(AlgorithmSpec.parse(text))
-    return out
+    """The candidates for a log of ``kind`` (None: both kinds): every registered family's
+    own (:meth:`~strapdown.algorithms.family.Family.candidates`), increment families first,
+    each kind in registry order."""
+    kinds: tuple[InputKind, ...] = ("increment", "rate") if kind is None else (kind,)
+    return [spec for k in kinds for fam in REGISTRY.values() if fam.input_kind == k
+            for spec in fam.candidates()]
 
 
 def log_spectrum(log: ImuLog, *, nperseg: int = 256
@@ -460,8 +449,7 @@ def gap_notes(cands: Sequence[Candidate], accuracy_deg_h: float = 0.0,
             key = "below"
         elif spec.input_kind == "rate":
             key = "rate"
-        elif (spec.algorithm == "rotvec" and spec.subsamples >= 4
-              and spec.coefficients is None and spec.structure != "single-chain"):
+        elif spec.family.amplitude_cubed(spec):
             key = "cubed"
         else:
             key = "higher"

@@ -92,13 +92,13 @@ def compare_motion(base: EvaluationConfig, specs: Iterable[str], out: str | os.P
     specs = list(specs)
     if not specs:
         raise InputError("give at least one algorithm spec")
-    if base.motion == "sculling":
+    if base.kind.has_metric("velocity_error_rate_m_s2"):  # a velocity motion (sculling)
         return _compare_sculling(base, specs, out, progress)
     runs, notes = [], []
     for k, spec in enumerate(specs, start=1):
         if progress is not None:
             progress(f"[{k}/{len(specs)}] {spec}")
-        cfg = dataclasses.replace(base, **parse_spec(spec))
+        cfg = base.with_spec(spec)
         ev = evaluate(cfg)
         d = ev.to_dict()
         runs.append(AlgorithmRun(spec, ev.t, ev.angle, _summary_row(
@@ -124,7 +124,7 @@ def _compare_sculling(base: EvaluationConfig, specs: list[str], out: str | os.Pa
     for k, spec in enumerate(specs, start=1):
         if progress is not None:
             progress(f"[{k}/{len(specs)}] {spec}")
-        ev = run_evaluation(dataclasses.replace(base, **parse_spec(spec)))
+        ev = run_evaluation(base.with_spec(spec))
         d = ev.to_dict()
         pred = d["predicted_velocity_error_rate_m_s2"]
         dv = np.linalg.norm(ev.dv, axis=1)  # type: ignore[union-attr]

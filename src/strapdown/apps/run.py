@@ -574,6 +574,40 @@ def run_log(imu: str | os.PathLike[str], out: str | os.PathLike[str], *,
         too, by :func:`strapdown.io.read_imu`'s rules), or a non-finite or empty result.
     """
     imu_path, out_path = Path(imu), Path(out)
+    kind = _checked_paths(imu_path, out_path, kind, angles, on_gap, columns, delimiter)
+    resample = resample or timing == "resample"
+    spec = _spec(kind, algorithm, structure, subsamples, coefficients)
+    q_init = None if q0 is None else _unit_quaternion(q0)
+    check_read_options(kind=kind, units=units, gap_tolerance=gap_tolerance, on_gap="report",
+                       saturation=saturation, sample_rate_hz=sample_rate_hz, columns=columns)
+    input_file(imu_path, "log file")
+    if resample and kind != "rate":
+        raise InputError("--resample applies to rate logs (--rates) only")
+    read = {"kind": kind, "units": units, "columns": columns, "sample_rate_hz": sample_rate_hz,
+            "gap_tolerance": gap_tolerance, "on_gap": "error" if on_gap == "error" else "report",
+            "saturation": saturation, "unit_check": unit_action(accept_unit_warning),
+            "delimiter": delimiter,
+            **_time_base_options(timing, jitter_tolerance, held, duplicates)}
+    split = on_gap == "split"
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        with output_with_sidecar(out_path) as paired:
+            if spec.input_kind == "rate":
+                res = _run_rates(imu_path, paired.path, read, spec, angles, q_init, split,
+                                 resample, progress)
+            else:
+                res = _run_increments(imu_path, paired.path, read, spec, angles, q_init, split,
+                                      progress)
+            paired.meta = _metadata(imu_path, spec, res, on_gap, saturation,
+                                    [str(w.message) for w in caught], q_init)
+    return paired.meta
+
+
+def _checked_paths(imu_path: Path, out_path: Path, kind: InputKind | None, angles: str,
+                   on_gap: str, columns: Sequence[str] | None, delimiter: str | None
+                   ) -> InputKind:
+    """:func:`run_log`'s first checks (output path and format, angles, gap policy, columns);
+    the log's kind, from its header when not given."""
     if out_path.resolve() == imu_path.resolve():
         raise InputError("--out must not be the input file")
     if out_path.suffix.lower() not in (".csv", ".npz"):
@@ -589,39 +623,21 @@ def run_log(imu: str | os.PathLike[str], out: str | os.PathLike[str], *,
             raise InputError(f"{imu_path}: does the log hold rates or increments? Its header "
                              "does not say (a unit such as gx[rad/s] or gx[rad] would); pass "
                              "--rates or --increments")
-    resample = resample or timing == "resample"
-    spec = _spec(kind, algorithm, structure, subsamples, coefficients)
-    q_init = None if q0 is None else _unit_quaternion(q0)
-    check_read_options(kind=kind, units=units, gap_tolerance=gap_tolerance, on_gap="report",
-                       saturation=saturation, sample_rate_hz=sample_rate_hz, columns=columns)
-    input_file(imu_path, "log file")
-    if resample and kind != "rate":
-        raise InputError("--resample applies to rate logs (--rates) only")
-    read = {"kind": kind, "units": units, "columns": columns, "sample_rate_hz": sample_rate_hz,
-            "gap_tolerance": gap_tolerance, "on_gap": "error" if on_gap == "error" else "report",
-            "saturation": saturation, "unit_check": unit_action(accept_unit_warning),
-            "delimiter": delimiter}
-    # the time base's options, when not the defaults (a log read with the defaults may
-    # stream: see _rate_scan)
+    return kind
+
+
+def _time_base_options(timing: TimingMode, jitter_tolerance: float, held: HeldPolicy,
+                       duplicates: DuplicatePolicy) -> dict[str, Any]:
+    """The time base's read options that are not the defaults (a log read with the defaults
+    may stream: see _rate_scan)."""
+    out: dict[str, Any] = {}
     for key, value, default in (("timing_mode", "auto" if timing == "resample" else timing,
                                  "auto"), ("jitter_tolerance", jitter_tolerance,
                                            JITTER_TOLERANCE), ("held", held, "auto"),
                                 ("duplicates", duplicates, "error")):
         if value != default:
-            read[key] = value
-    split = on_gap == "split"
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        with output_with_sidecar(out_path) as paired:
-            if spec.input_kind == "rate":
-                res = _run_rates(imu_path, paired.path, read, spec, angles, q_init, split,
-                                 resample, progress)
-            else:
-                res = _run_increments(imu_path, paired.path, read, spec, angles, q_init, split,
-                                      progress)
-            paired.meta = _metadata(imu_path, spec, res, on_gap, saturation,
-                                    [str(w.message) for w in caught], q_init)
-    return paired.meta
+            out[key] = value
+    return out
 
 
 def _metadata(imu: Path, spec: AlgorithmSpec, res: dict[str, Any], on_gap: str,

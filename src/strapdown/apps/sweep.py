@@ -80,10 +80,11 @@ import numpy as np
 from strapdown._core.errors import InputError, shown
 from strapdown.algorithms.spec import parse_spec
 from strapdown.analysis.evaluate import (
+    CONFIG_FIELDS,
     METRICS,
-    SCULLING_METRICS,
     EvaluationConfig,
     MetricName,
+    motion_kind,
     run_evaluation,
 )
 from strapdown.io.files import atomic_path, csv_table, write_text
@@ -115,7 +116,7 @@ def default_formats() -> tuple[TableFormat, ...]:
     except ImportError:
         return ("csv",)
     return FORMATS
-_CONFIG_FIELDS = {f.name for f in dataclasses.fields(EvaluationConfig)} - {"gyro", "seed"}
+_CONFIG_FIELDS = set(CONFIG_FIELDS) - {"gyro", "seed"}
 _GYRO_FIELDS = {f.name for f in dataclasses.fields(GyroErrors)}
 _SECTIONS = ("motion", "sensor", "run")
 _TOP = {"algorithms", "metrics", "seed", "grid", "gyro", *_SECTIONS}
@@ -147,7 +148,7 @@ class Case:
     @property
     def key(self) -> str:
         """Hash of everything that determines the result."""
-        c = dataclasses.asdict(self.config)
+        c = self.config.flat()  # the spec's fields flat beside the rest, as ever
         text = json.dumps({"config": c, "metrics": self.metrics}, sort_keys=True,
                           default=_jsonable)
         return hashlib.sha256(text.encode()).hexdigest()[:20]
@@ -314,9 +315,13 @@ def load_scenario(path) -> Scenario:
             raise InputError(f"{path}: {exc}") from None
     if len(set(algorithms)) != len(algorithms):
         raise InputError(f"{path}: an algorithm spec appears twice")
-    sculling = base.get("motion") == "sculling"
+    try:
+        kind = motion_kind(base.get("motion", EvaluationConfig.motion))
+    except ValueError:
+        kind = None  # an unknown motion is refused with its case below
+    velocity = kind is not None and kind.has_metric("velocity_error_rate_m_s2")
     metrics = _strings(path, doc, "metrics",
-                       list(SCULLING_DEFAULT_METRICS if sculling else DEFAULT_METRICS))
+                       list(SCULLING_DEFAULT_METRICS if velocity else DEFAULT_METRICS))
     if "predicted_drift_rad_s" in metrics:  # a law in the table comes with what it means
         metrics += [m for m in LAW_COLUMNS if m not in metrics]
     bad = [m for m in metrics if m not in METRICS]
@@ -372,7 +377,8 @@ def cases(scn: Scenario) -> list[Case]:
         cfg_fields, errors, seed = _point_config(scn, p, params)
         for a in scn.algorithms:
             try:
-                cfg = EvaluationConfig(**{**cfg_fields, **parse_spec(a)}, gyro=errors, seed=seed)
+                cfg = EvaluationConfig.of(**{**cfg_fields, **parse_spec(a)}, gyro=errors,
+                                          seed=seed)
                 cfg.validate()
                 _ = cfg.samples
                 _check_runs(cfg)
@@ -397,12 +403,11 @@ def _check_runs(cfg: EvaluationConfig) -> None:
     error stays within what the samples resolve — a bias, Gauss–Markov σ and white noise
     per sample (``σ·√h``) turning the body by at most π per sample (Nyquist, as the motion
     rates), scale factors and misalignments within ±:data:`MAX_RELATIVE_ERROR`."""
-    if cfg.motion == "spin" and cfg.spin_rate_dps == 0:
-        raise InputError("pure spin needs a non-zero spin_rate_dps")
-    if cfg.motion != "sculling":
-        from strapdown.analysis.evaluate import build_motion
-
-        build_motion(cfg)
+    if cfg.kind.truth is not None:
+        try:
+            cfg.kind.truth(cfg)  # the motion is built (pure spin needs a spin rate)
+        except ValueError as exc:  # name the scenario's key, not the command line's option
+            raise InputError(str(exc).replace("--spin-rate-dps", "spin_rate_dps")) from None
     e = cfg.gyro
     if e is None:
         return
@@ -424,12 +429,11 @@ def _check_runs(cfg: EvaluationConfig) -> None:
 def _check_metrics(cfg: EvaluationConfig, metrics: Iterable[str]) -> None:
     """The metrics must be the motion's: velocity metrics on the sculling motion, attitude
     metrics elsewhere (``update_period_s`` and ``samples`` on both)."""
-    velocity = set(SCULLING_METRICS) - {"update_period_s", "samples"}
-    if cfg.motion == "sculling":
-        bad = [m for m in metrics if m not in SCULLING_METRICS]
-        what = "the sculling motion has the velocity metrics " + ", ".join(SCULLING_METRICS)
+    kind = cfg.kind
+    bad = [m for m in metrics if not kind.has_metric(m)]
+    if kind.metrics is not None:
+        what = f"the {cfg.motion} motion has the velocity metrics " + ", ".join(kind.metrics)
     else:
-        bad = [m for m in metrics if m in velocity]
         what = f"the {cfg.motion} motion has no velocity metrics (those are the sculling's)"
     if bad:
         raise InputError(f"metric(s) {', '.join(bad)} do not apply: {what}")

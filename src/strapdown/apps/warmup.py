@@ -67,25 +67,26 @@ def warmup(parts: Iterable[Part] = PARTS, *,
 def _attitude() -> None:
     """Every registered algorithm in every structure it runs in, on a short coning motion
     (the finite-amplitude sets too: their triple terms are kernels of their own)."""
+    from strapdown.algorithms.rate import RK4_STEPS
     from strapdown.algorithms.spec import REGISTRY
     from strapdown.analysis.evaluate import EvaluationConfig, evaluate
 
     for name, fam in REGISTRY.items():
+        configs: list[dict] = []
         if fam.stepped:  # the quaternion algorithms take whole steps: a motion of their own
-            configs = [EvaluationConfig(motion="krylov", algorithm=name, duration=2.0,
-                                        step=0.1, alpha=0.45, beta=0.675)]
+            configs = [dict(motion="krylov", algorithm=name, duration=2.0, step=0.1,
+                            alpha=0.45, beta=0.675)]
         else:
             sets: list[CoefficientName | None] = [None]
-            if name == "rotvec":
+            if fam.coning_sets:
                 sets.append("finite-amplitude")
-            steps: list[Rk4Step] = ["2td", "td-interp"] if name == "rk4" else ["2td"]
-            configs = [EvaluationConfig(algorithm=name, structure=s, coefficients=c,
-                                        rk4_step=r, sample_rate_hz=600.0, duration=0.2)
-                       for s in fam.structures for c in sets for r in steps
-                       if not (s == "realtime" and c == "finite-amplitude")]
-        for cfg in configs:
+            steps: list[Rk4Step] = list(RK4_STEPS) if "rk4_step" in fam.options else ["2td"]
+            configs = [dict(algorithm=name, structure=s, coefficients=c, rk4_step=r,
+                            sample_rate_hz=600.0, duration=0.2)
+                       for s in fam.structures for c in sets for r in steps]
+        for fields in configs:
             try:
-                evaluate(cfg)
+                evaluate(EvaluationConfig.of(**fields))
             except ValueError:  # a combination the family refuses: nothing to compile
                 pass
 

@@ -73,7 +73,7 @@ def run(args: argparse.Namespace) -> int:
         lines.append(f"  {term:{width}s}  {frac:>14s}  {dec: .17g}")
     if not rec["terms"]:
         lines.append("  (no cross-product terms)")
-    if args.target == "sculling":
+    if args.target == "sculling":  # lint-model: a designer's target, not the motion
         lines.append(f"velocity      {_law(d.drift_constant, d.order, 'θ0 A cos ψ')} rectified "
                      "velocity error rate, normal to both vibrations")
     elif rec["drift_law"].startswith("rectified velocity error rate along the cone axis"):
@@ -99,7 +99,8 @@ def _run_triple(args: argparse.Namespace, st) -> int:
     if args.form not in _TRIPLE_FORMS:
         raise ValueError(f"--triple applies to the forms {', '.join(_TRIPLE_FORMS)}, "
                          f"not {args.form!r}")
-    if args.target != "coning" or args.ignore_quadrature or args.subsamples < 2:
+    classical = args.target == "coning"  # lint-model: a designer's target, not the motion
+    if not classical or args.ignore_quadrature or args.subsamples < 2:
         raise ValueError("--triple designs for classical coning (--target coning) with N ≥ 2")
     d = derive_triple(with_last_triples(st))
     rec = d.to_dict()

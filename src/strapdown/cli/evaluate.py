@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+from typing import TYPE_CHECKING
 
 from strapdown.cli._common import (
     algorithm_help,
@@ -12,6 +13,9 @@ from strapdown.cli._common import (
     print_json,
     structure_help,
 )
+
+if TYPE_CHECKING:
+    from strapdown.algorithms.spec import AlgorithmSpec
 
 __all__ = ["add_parser", "run", "sculling_args"]
 
@@ -88,7 +92,7 @@ def run(args: argparse.Namespace) -> int:
     """Evaluate the configuration and print the result (text or ``--json``)."""
     from strapdown.analysis.evaluate import EvaluationConfig, run_evaluation
 
-    cfg = EvaluationConfig(
+    cfg = EvaluationConfig.of(
         motion=args.motion, half_angle_deg=args.half_angle_deg, cone_rate_hz=args.cone_rate_hz,
         spin_rate_dps=args.spin_rate_dps, sample_rate_hz=args.sample_rate_hz,
         duration=args.duration, algorithm=args.algorithm, subsamples=args.subsamples,
@@ -102,8 +106,9 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         print_json(res)
         return 0
-    text = _sculling_text if args.motion == "sculling" else _text
-    print("\n".join(text(args, res)))
+    velocity = cfg.kind.has_metric("velocity_error_rate_m_s2")  # the motion's own record
+    text = _sculling_text if velocity else _text
+    print("\n".join(text(args, res, cfg.spec)))
     return 0
 
 
@@ -111,7 +116,7 @@ def _vec(v) -> str:
     return "n/a" if v is None else "[" + ", ".join(f"{x:.6e}" for x in v) + "]"
 
 
-def _sculling_text(args: argparse.Namespace, res: dict) -> list[str]:
+def _sculling_text(args: argparse.Namespace, res: dict, spec: AlgorithmSpec) -> list[str]:
     arith = f"mpmath, {args.precision} digits" if args.precision else "float64"
     ratio = res["velocity_rate_over_law"]
     axis = "navigation z"
@@ -137,9 +142,9 @@ def _sculling_text(args: argparse.Namespace, res: dict) -> list[str]:
     ]
 
 
-def _text(args: argparse.Namespace, res: dict) -> list[str]:
+def _text(args: argparse.Namespace, res: dict, spec: AlgorithmSpec) -> list[str]:
     arith = f"mpmath, {args.precision} digits" if args.precision else "float64"
-    n = f", N = {args.subsamples}" if args.algorithm == "rotvec" else ""
+    n = f", N = {args.subsamples}" if "subsamples" in spec.family.options else ""
     coeffs = f", coefficients {res['coefficients']}" if res["coefficients"] else ""
     lines = [
         f"motion        {args.motion}",

@@ -52,8 +52,8 @@ ALGS: list[tuple[str, RateAlgorithmName, StructureName, RateCoefficients | None,
 
 
 def _cfg(alg, structure, coeffs, step, **kw):
-    return EvaluationConfig(algorithm=alg, structure=structure, coefficients=coeffs,
-                            rk4_step=step, cone_rate_hz=1.0, **kw)
+    return EvaluationConfig.of(algorithm=alg, structure=structure, coefficients=coeffs,
+                               rk4_step=step, cone_rate_hz=1.0, **kw)
 
 
 def _cone_drift(res) -> float:
@@ -263,9 +263,9 @@ def _rate_vs_increment(r: Report) -> str:
             ("rates: RK4 step 2td", dict(algorithm="rk4")),
         ]
         for label, kw in cases:
-            res = evaluate(EvaluationConfig(half_angle_deg=1.0, cone_rate_hz=1.0,
-                                            sample_rate_hz=rate_hz, duration=2.0, precision=40,
-                                            **kw))
+            res = evaluate(EvaluationConfig.of(half_angle_deg=1.0, cone_rate_hz=1.0,
+                                               sample_rate_hz=rate_hz, duration=2.0,
+                                               precision=40, **kw))
             rows.append([f"{rate_hz:.0f}", label, f"{res.update_period * 1e3:.3g}",
                          f"{res.cone_axis_drift:.3e}",
                          "—" if res.predicted is None else f"{res.predicted:.3e}"])
