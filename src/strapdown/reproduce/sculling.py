@@ -487,10 +487,10 @@ def _coning_study(r: Report) -> dict[str, Any]:
           "(Ωh)⁴ with a constant growing with N; the coning-force sets (all pairs of the N "
           "subsamples) cancel it to order 2N. At 2° the new N ≥ 4 sets reach an a⁴ floor "
           "at rest (the law is a² only: halving a divides it by 16). On the flight the new "
-          "N ≥ 4 sets' height error grows with N in the turns (level flight keeps it small); "
-          "neither law explains it, and swapping the attitude set for the polynomial one "
-          "changes it little for N ≥ 5 — a term outside the coning-force target (coning "
-          "together with the turn's body rate), not resolved here.\n\n")
+          "N ≥ 4 sets' height error grows with N in the turns (level flight keeps it small): "
+          "mostly through the attitude, whose tilt error grows with N in the turns; the "
+          "velocity update alone, from the true attitude, adds at most ~1e-2 m there "
+          "(docs/reproductions.md).\n\n")
     r.add(r.table("coning_force", ["N", *(f"at rest: {lb} (m/s²)" for lb in labels),
                                    *(f"flight height: {lb} (m)" for lb in labels)], rows))
     conv_new, chain = labels[1], labels[2]
