@@ -65,3 +65,20 @@ def test_coning_force_record_and_bad_input():
         derive(rate_structure(2), target="coning-force")
     with pytest.raises(ValueError, match="one per pair"):
         velocity_error_laws(interval_structure(3), [Fraction(1)])
+
+
+@pytest.mark.parametrize("n", [2, 3, 4, 5, 6])
+def test_a_single_chain_with_pairs_among_earlier_samples_reaches_both_orders(n):
+    # the form extended (pairs among the window's earlier samples too, not only with the
+    # current one): both laws at order 2N, the coning-force constant twice the sculling one
+    from strapdown.design.designer import Structure
+
+    nodes = tuple(Fraction(s) for s in range(-(n - 1), 1))
+    pairs = tuple((i, j) for i in range(n) for j in range(i + 1, n))
+    st = Structure(f"single chain, window pairs, N = {n}", "increment", 1, nodes,
+                   tuple(Fraction(int(s == 0)) for s in nodes), pairs,
+                   tuple(((k, Fraction(1)),) for k in range(len(pairs))), n)
+    laws = velocity_error_laws(st, derive(st, target="coning-force", rule="min-norm")
+                               .coefficients)
+    assert laws["sculling"] == tables.SCULLING_DRIFT[n]
+    assert laws["coning-force"] == (2 * n, 2 * tables.SCULLING_DRIFT[n][1])
