@@ -133,6 +133,8 @@ def test_simulated_equals_library(tmp_path, algorithm, changes, mag):
         else:
             deg = np.degrees(err)
             assert deg.mean() <= FLOAT_MEAN_DEG and deg.max() <= FLOAT_MAX_DEG
+            norm = np.linalg.norm(q[e.init_samples - 1:], axis=1)
+            assert np.all(np.abs(norm - 1.0) <= 1e-6)  # the 10^7 run: benchmarks/ahrs_c_stream.py
 
 
 def test_chunks_equal_one_stream(tmp_path):
