@@ -84,6 +84,9 @@ F_ACC_DISTURBED = int(MeasurementFlag.ACC_DISTURBED)
 # _mag_disturbance): reference norm and dip, time undisturbed, disturbed (0/1), candidate
 # norm, dip and time, time rejected
 M_NORM, M_DIP, M_UNDIST, M_DIST, M_CNORM, M_CDIP, M_CT, M_REJECT = range(8)
+#: The slow mean of the low-passed specific force (:func:`_motion_power`) has this many
+#: times the low-pass's time constant.
+MOTION_SLOW = 4.0
 
 
 class Sensors(NamedTuple):
@@ -163,6 +166,8 @@ class Params(NamedTuple):
     lever_arm: float
     acc_lowpass: bool  #: acc_model == "lowpass" (else "raw")
     acc_lowpass_noise: float
+    acc_lowpass_s: float
+    acc_motion_leak: float
     acc_lowpass_norm_tol: float
     gravity_measured: float  #: the specific force's norm over the initial window
     acc_gate_lowpass: float
@@ -178,6 +183,8 @@ class Params(NamedTuple):
     lp_a1: float  #: denominator (a0 = 1),
     lp_a2: float
     lp_init_n: int  #: epochs averaged before the filter starts
+    dyn_k: float  #: gain per epoch of the motion acceleration's moving mean square
+    dyn_k2: float  #: gain per epoch of the slow mean of the low-passed specific force
     mc_b0: float  #: the low-pass of the field's norm and dip, likewise
     mc_b1: float
     mc_b2: float
@@ -190,6 +197,8 @@ class Params(NamedTuple):
     mag_delay_max: int  #: the estimator's largest candidate, samples
     mag_delay_alpha: float  #: its averaging gain per sample
     store_covariance: bool  #: write attitude_cov and bias_var (the offline combination)
+    meas_lead: float  #: how far the magnetometer's samples lead the attitude they update, s
+    #: (half a period for point field samples beside interval gyro samples; :func:`_at_state_time`)
 
 
 class Initial(NamedTuple):
@@ -629,8 +638,11 @@ def _add_process_noise(P, C, phi, T, qg, qb, qa, qab, params, singer):
 def _rest_detect(ema_n, rest_alpha, params, gm, g2, am, a2):
     """Stage 4, detection from the moving averages; returns (acc_quiet, at_rest).
 
-    Quiet accelerometer: low variance and a mean of magnitude g (no sustained
-    manoeuvre); at rest: also a gyro of low variance and small mean.
+    Quiet accelerometer: low variance and a mean of gravity's magnitude as this
+    accelerometer measures it (``gravity_measured``, over the initial window: an
+    uncalibrated scale factor of a few per cent — OpenAXES's sensors read 9.44 m/s² at
+    rest — is not a sustained manoeuvre); at rest: also a gyro of low variance and small
+    mean.
     """
     sg = 0.0
     sacc = 0.0
@@ -640,8 +652,8 @@ def _rest_detect(ema_n, rest_alpha, params, gm, g2, am, a2):
     wm2 = gm[0] ** 2 + gm[1] ** 2 + gm[2] ** 2
     settled = ema_n * rest_alpha > 1.0
     ra = params.rest_acc
-    acc_quiet = (settled and sacc < ra * ra
-                 and abs(np.sqrt(am[0] ** 2 + am[1] ** 2 + am[2] ** 2) - params.gravity) < ra)
+    a_norm = np.sqrt(am[0] ** 2 + am[1] ** 2 + am[2] ** 2)
+    acc_quiet = settled and sacc < ra * ra and abs(a_norm - params.gravity_measured) < ra
     rg = params.rest_gyro
     at_rest = acc_quiet and sg < rg * rg and wm2 < params.rest_gyro_mean ** 2
     return acc_quiet, at_rest
@@ -718,6 +730,38 @@ def _acc_lowpass_model(lp_n, params, C, fk, fn, lp, s0, s1, dx, H, y):
     y[1] = lp[1]
     _sub_hdx(y, H, dx)
     return lp_n
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _motion_power(dyn2, lp_n, params, lp, lp2):
+    """Stage 5, low-pass model: what of the motion acceleration the low-pass lets through,
+    seen as the low-passed specific force ``lp`` less a slower mean of it ``lp2`` (time
+    constant ``MOTION_SLOW`` × ``acc_lowpass_s``, in the same reference frame) on the
+    horizontal axes; returns its moving mean square (time constant ``acc_lowpass_s``;
+    zero while the low-pass is still averaging). Tilt errors change slowly, gravity not
+    at all: a swing's or a circle's slow acceleration is what moves ``lp`` from ``lp2``."""
+    if lp_n < params.lp_init_n:
+        for a in range(3):
+            lp2[a] = lp[a]
+        return dyn2
+    d2 = 0.0
+    for a in range(3):
+        lp2[a] += params.dyn_k2 * (lp[a] - lp2[a])
+        if a < 2:
+            d2 += (lp[a] - lp2[a]) ** 2
+    return dyn2 + params.dyn_k * (d2 - dyn2)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _lowpass_variance(params, dyn2, T):
+    """Stage 5, low-pass model: the measurement variance per horizontal axis, ``R = (n² +
+    κ² τ ā²)/T``: the noise density ``n`` (``acc_lowpass_noise``) and the part of the
+    motion acceleration (mean square ``ā²``, :func:`_motion_power`) that the low-pass of
+    time constant ``τ`` lets through — a fraction ``κ`` (``acc_motion_leak``), correlated
+    over ``τ``. A body that swings or circles for minutes is weighed by what its
+    accelerometer shows, not dragged by it."""
+    k2 = params.acc_motion_leak * params.acc_motion_leak
+    return (params.acc_lowpass_noise ** 2 + k2 * params.acc_lowpass_s * dyn2) / T
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -817,13 +861,35 @@ def _fold_delay_samples(last, k, n_seen, x, mag, h, is_rate, bias, alpha, res):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _delayed_field(ringC, j, mag, k, mn):
-    """Stage 6: the field sample k in the reference frame, ``mn = C_j m_k`` with the
-    attitude ``ringC[j]`` of the magnetometer's delay earlier (it lags the gyro);
-    returns its norm."""
+def _delayed_field(ringC, j, mk, mn):
+    """Stage 6: the field sample ``mk`` (body frame, :func:`_at_state_time`) in the
+    reference frame, ``mn = C_j m_k`` with the attitude ``ringC[j]`` of the magnetometer's
+    delay earlier (it lags the gyro); returns its norm."""
     for a in range(3):
-        mn[a] = ringC[j, a, 0] * mag[k, 0] + ringC[j, a, 1] * mag[k, 1] + ringC[j, a, 2] * mag[k, 2]
+        mn[a] = ringC[j, a, 0] * mk[0] + ringC[j, a, 1] * mk[1] + ringC[j, a, 2] * mk[2]
     return np.sqrt(mn[0] ** 2 + mn[1] ** 2 + mn[2] ** 2)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _at_state_time(v, k, x, h, is_rate, bias, lead, out):
+    """Stage 6: a body-frame sample ``v`` of a fixed reference-frame vector (the field)
+    taken at sample k's stamp, as it was ``lead`` seconds earlier — when the filter's
+    attitude refers (``Params.meas_lead``: half a period for a field sampled at the stamp
+    beside interval gyro samples, whose attitude refers to the middle of the sample
+    period, as does the accelerometer's mean): ``v(t − δ) = exp(δ[ω×]) v(t)`` to second
+    order, ω the bias-corrected rate of sample k. Without it a body spinning at ω sees
+    its field turned by ωδ against the attitude — 0.67° at 9.4 rad/s and 400 Hz, a
+    steady heading error."""
+    kk = min(k, x.shape[0] - 1)
+    w0 = lead * ((x[kk, 0] if is_rate else x[kk - 1, 0] / h) - bias[0])
+    w1 = lead * ((x[kk, 1] if is_rate else x[kk - 1, 1] / h) - bias[1])
+    w2 = lead * ((x[kk, 2] if is_rate else x[kk - 1, 2] / h) - bias[2])
+    c0 = w1 * v[2] - w2 * v[1]
+    c1 = w2 * v[0] - w0 * v[2]
+    c2 = w0 * v[1] - w1 * v[0]
+    out[0] = v[0] + c0 + 0.5 * (w1 * c2 - w2 * c1)
+    out[1] = v[1] + c1 + 0.5 * (w2 * c0 - w0 * c2)
+    out[2] = v[2] + c2 + 0.5 * (w0 * c1 - w1 * c0)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -1044,6 +1110,7 @@ def ekf_kernel(sensors, prop, window, params, init, out):
     C = np.empty((3, 3))
     dx = np.zeros(nx)
     fk = np.empty(3)
+    mk = np.empty(3)
     fn = np.zeros(3)
     lp = np.zeros(3)
     lp_s0 = np.zeros(3)
@@ -1092,6 +1159,8 @@ def ekf_kernel(sensors, prop, window, params, init, out):
     ms[M_CNORM] = params.ref_norm
     ms[M_CDIP] = params.ref_dip
     ms[M_UNDIST] = params.mag_settle_s
+    dyn2 = 0.0  # moving mean square of the motion acceleration through the low-pass
+    lp2 = np.zeros(3)  # slow mean of the low-passed specific force
     rest_since = -1.0  # start of the current run of rest detections (−1: none)
     acc_bad_since = -1.0  # start of the current run of rejections (−1: none)
     mag_bad_since = -1.0
@@ -1144,13 +1213,14 @@ def ekf_kernel(sensors, prop, window, params, init, out):
             if params.acc_lowpass:
                 lp_n = _acc_lowpass_model(lp_n, params, C, fk, fn, lp, lp_s0, lp_s1, dx, H_lp,
                                           y2)
+                dyn2 = _motion_power(dyn2, lp_n, params, lp, lp2)
                 # a sustained acceleration (a coordinated turn) does not average out: the
                 # low-passed specific force is then longer than gravity
                 disturbed = params.gating and not _lowpass_plausible(lp, params)
                 ok = False
                 if not disturbed:
                     nis_acc, ok = _gated_update(P, H_lp, 3 if nx == 6 else nx,
-                                                params.acc_lowpass_noise ** 2 / T, y2,
+                                                _lowpass_variance(params, dyn2, T), y2,
                                                 params.acc_gate_lowpass, params.gating, force,
                                                 params.soft_gate, dx, U2, S2, Si2)
             else:
@@ -1180,8 +1250,9 @@ def ekf_kernel(sensors, prop, window, params, init, out):
                 if n_delay_seen > 0:
                     delay = int(np.argmin(delay_res))
             _store_dcm(ringC, step % n_delay, C)
+            _at_state_time(mag[k], k, x, h, is_rate, bias, params.meas_lead, mk)
             nb = _delayed_field(ringC, (step - (delay + prop.stride // 2) // prop.stride)
-                                % n_delay, mag, k, mn)
+                                % n_delay, mk, mn)
             nd_raw[0] = nb
             nd_raw[1] = -np.arcsin(min(max(mn[2] / nb, -1.0), 1.0)) if nb > 0.0 else 0.0
             mc_n = _lowpass(nd_raw, mc_n, params.mc_init_n, params.mc_b0, params.mc_b1,
@@ -1214,6 +1285,7 @@ def ekf_kernel(sensors, prop, window, params, init, out):
             _rotate_small(eps, lp)
             _rotate_small(eps, lp_s0)
             _rotate_small(eps, lp_s1)
+            _rotate_small(eps, lp2)
         # stage 8: record
         for i in range(4):
             out_q[k, i] = q[i]
