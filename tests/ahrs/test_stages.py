@@ -501,8 +501,6 @@ def test_raw_model_plausibility_lever_arm_and_recovery(k):
     assert np.allclose(np.diag(P), [0.01] * 3 + [0] * 3, rtol=1e-15)
 
 
-@pytest.mark.xfail(strict=True, reason="_kernel._lever_sigma reads x[k], on increments the "
-                   "interval after sample k: the raw model with rotvec:N=… looks one sample ahead")
 def test_lever_sigma_on_increments_is_causal(k):
     """An epoch ending at sample k may use increments up to interval k − 1 → k (``x[k − 1]``,
     as the rest detector does), never ``x[k]``, which ends at sample k + 1."""

@@ -786,14 +786,15 @@ def _acc_plausible(fk, params):
 @njit(cache=True, inline="always", error_model="numpy")
 def _lever_sigma(k, x, h, is_rate, bias, lever_arm):
     """Raw model: the standard deviation that rotation seen at a lever arm adds to the
-    accelerometer noise (centripetal ``|ω|²`` plus tangential ``|ω̇|``, times the arm)."""
-    kk = min(k, x.shape[0] - 1)
+    accelerometer noise (centripetal ``|ω|²`` plus tangential ``|ω̇|``, times the arm).
+    Causal: rates up to sample k, increments up to the interval that ends at it."""
+    kk = min(k, x.shape[0] - 1) if is_rate else k - 1
     w2 = 0.0
     wd2 = 0.0
     for a in range(3):
         wa = x[kk, a] - bias[a] if is_rate else x[kk, a] / h - bias[a]
         w2 += wa * wa
-        dw = x[kk, a] - x[kk - 1, a]
+        dw = x[kk, a] - x[max(kk - 1, 0), a]
         wd2 += (dw / h if is_rate else dw / (h * h)) ** 2
     return lever_arm * (w2 + np.sqrt(wd2))
 
