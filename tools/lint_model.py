@@ -52,7 +52,6 @@ MODEL_MODULES = frozenset({
     "algorithms/rate.py",
     "algorithms/quaternion.py",
     "algorithms/coning.py",
-    "analysis/motions.py",
 })
 
 #: Marks a comparison whose string is another vocabulary's word, with the reason after it.

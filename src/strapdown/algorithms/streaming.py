@@ -34,9 +34,6 @@ from strapdown.algorithms.structures import (
     _unit_q0,
     increment_structure,
     single_chain_coefficients,
-    single_chain_table,
-    stack_sets,
-    startup_sets,
 )
 
 if TYPE_CHECKING:
@@ -86,12 +83,12 @@ class RotvecStream:
         self.n = coefficients.n
         self._triple = triple_arrays(coefficients.triples)
         if st.own_startup:  # the single chain: its own table
-            self._table = single_chain_table(st.chain_subsamples(coefficients))
+            self._table = st.table(coefficients)
             if st.triple(coefficients):  # the single chain's own triple set
                 self._triple = triple_arrays(triple_terms("single-chain", self.n))
                 self._steady = np.array([float(c) for c in single_chain_coefficients(self.n)])
         if st.interleaved:
-            self._ks = stack_sets(startup_sets(coefficients))
+            self._ks = st.table(coefficients)
         self._buf = _EMPTY  # increments carried over
         self._qhist: NDArray[np.float64] | None = None  # last attitude(s)
         self._count = 0  # increments consumed so far

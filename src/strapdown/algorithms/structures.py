@@ -156,6 +156,13 @@ class UpdateStructure(str):
         self.check_set(coefficients)
         return bool(coefficients.triples)
 
+    def table(self, coefficients: CoefficientSet) -> NDArray[np.float64]:
+        """The coefficient table its kernel reads for ``coefficients``: the N × N matrix
+        (conventional), the start-up sets stacked ``(N, N, N)`` (real-time), the start-up
+        and steady single-chain coefficients ``(N, N − 1)`` (single chain)."""
+        self.check_set(coefficients)
+        return np.ascontiguousarray(coefficients.matrix)
+
     def run(self, increments: ArrayLike | GyroRecord | ImuLog, coefficients: CoefficientSet,
             *, h: float | None = None, t0: float | None = None, q0: ArrayLike | None = None
             ) -> AttitudeSolution:
@@ -176,6 +183,10 @@ class _Realtime(UpdateStructure):
     interleaved = True
     pair_only = True
     description = "Li & Zhang's real-time structure: an output every h from N chains"
+
+    def table(self, coefficients: CoefficientSet) -> NDArray[np.float64]:
+        self.check_set(coefficients)
+        return stack_sets(startup_sets(coefficients))
 
     def run(self, increments, coefficients, *, h=None, t0=None, q0=None):
         return realtime(increments, coefficients, h=h, t0=t0, q0=q0)
@@ -206,6 +217,9 @@ class _SingleChain(UpdateStructure):
         """Whether the chain adds its own triple terms (the finite-amplitude set)."""
         self.check_set(coefficients)
         return self._SETS[coefficients.name][1]
+
+    def table(self, coefficients: CoefficientSet) -> NDArray[np.float64]:
+        return single_chain_table(self.chain_subsamples(coefficients))
 
     def run(self, increments, coefficients, *, h=None, t0=None, q0=None):
         return single_chain(increments, self.chain_subsamples(coefficients), h=h, t0=t0,
