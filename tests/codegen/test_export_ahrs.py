@@ -111,6 +111,10 @@ OPTIONS = [
     ("rate-single", {"estimate_mag_delay": False, "mag_delay_s": 0.02,
                      "mag_disturbed_power": 1.0, "heading_rate_noise": 1e-3}, True),
     ("rate-single", {"rest_update": False, "use_accelerometer": False}, True),
+    # issue 25's kernel: the motion-acceleration weight, and field samples not turned
+    ("rate-single", {"acc_motion_leak": 0.5}, True),
+    ("rate-single", {"acc_motion_leak": 0.3, "estimate_acc_bias": True, "mag_sample": "interval"},
+     True),
 ]
 
 
