@@ -53,15 +53,20 @@ def _drive(e, lib, g, a, pos0, v0, q0):
     return np.array(rows), state, lib
 
 
-@pytest.mark.parametrize(("structure", "n"), [("conventional", 1), ("conventional", 2),
-                                              ("conventional", 4), ("single-chain", 3),
-                                              ("single-chain", 6)])
-def test_nav_c_equals_the_library(tmp_path, log, structure, n):
+@pytest.mark.parametrize(("structure", "n", "vset"), [
+    ("conventional", 1, None), ("conventional", 2, None), ("conventional", 3, None),
+    ("conventional", 4, None), ("conventional", 6, None), ("conventional", 3, "classical"),
+    ("conventional", 4, "classical"), ("single-chain", 3, None), ("single-chain", 6, None)])
+def test_nav_c_equals_the_library(tmp_path, log, structure, n, vset):
+    """The C runs the library's default velocity set (what ``strapdown nav`` runs) unless told
+    another with ``velocity_set``, as ``navigate`` does."""
     g, a, pos0, v0, q0 = log
-    e, lib = build(tmp_path, algorithm="nav", structure=structure, subsamples=n)
+    kw = {} if vset is None else {"velocity_set": vset}
+    e, lib = build(tmp_path, algorithm="nav", structure=structure, subsamples=n, **kw)
     c, _, _ = _drive(e, lib, g, a, pos0, v0, q0)
-    sol = navigate(g, a, n, h=H, lat=pos0[0], lon=pos0[1], height=pos0[2], v0=v0, q0=q0,
-                   structure=structure, velocity_set="classical")  # export-c's set
+    k = g.shape[0] // n * n if structure == "conventional" else g.shape[0]  # whole updates
+    sol = navigate(g[:k], a[:k], n, h=H, lat=pos0[0], lon=pos0[1], height=pos0[2], v0=v0,
+                   q0=q0, structure=structure, trailing="error", **kw)
     py = np.column_stack([sol.lat, sol.lon, sol.height, sol.v, sol.q])[1:]
     assert c.shape == py.shape
     scale = np.array([1.0, 1.0, 1e3, 1e2, 1e2, 1e2, 1.0, 1.0, 1.0, 1.0])  # rad, m, m/s, q
@@ -113,6 +118,23 @@ def test_bad_nav_export(tmp_path, kw, msg):
         export_c(tmp_path, algorithm="nav", **kw)
 
 
+def test_default_and_classical_sets_differ_from_n_3_only():
+    """N ≤ 2 has one velocity set (the C is the same text); from N = 3 the default pairs
+    every two subsamples, the classical set only those with the last one."""
+    for n in (1, 2):
+        assert (generate("nav", subsamples=n).source
+                == generate("nav", subsamples=n, velocity_set="classical").source)
+    default = generate("nav", subsamples=3)
+    classical = generate("nav", subsamples=3, velocity_set="classical")
+    pairs = [len(re.findall(r"sd_cross_add\(dvb", e.source)) for e in (default, classical)]
+    assert pairs == [6, 4]  # 3 pairs x 2 (theta_i x v_j and v_i x theta_j); 2 pairs x 2
+    assert "coning-force" in default.header and "coning-force" not in classical.header
+    with pytest.raises(ValueError, match="unknown velocity set"):
+        generate("nav", subsamples=3, velocity_set="bogus")  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match="belongs to --algorithm nav"):
+        generate("rotvec", velocity_set="classical")
+
+
 def test_cli_writes_the_nav_code_and_rejects_a_sample_rate(tmp_path, capsys):
     from strapdown.cli import main
 
@@ -126,3 +148,11 @@ def test_cli_writes_the_nav_code_and_rejects_a_sample_rate(tmp_path, capsys):
               str(tmp_path / "x")])
     assert exc.value.code == 2 and "does not apply to nav" in capsys.readouterr().err
     assert not (tmp_path / "x").exists()
+    assert main(["export-c", "--algorithm", "nav", "--velocity-set", "classical",
+                 "--out", str(tmp_path / "cl")]) == 0
+    assert (tmp_path / "cl" / "sd_nav_conventional_n3.c").read_text() == generate(
+        "nav", velocity_set="classical").source
+    with pytest.raises(SystemExit) as exc:
+        main(["export-c", "--algorithm", "rotvec", "--velocity-set", "classical", "--out",
+              str(tmp_path / "y")])
+    assert exc.value.code == 2 and "belongs to --algorithm nav" in capsys.readouterr().err

@@ -36,6 +36,13 @@ def _arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--coefficients", default=None,
                    help="coefficient set; " + coefficients_help(ATTITUDE_ALGORITHMS)
                    + "; nav: table3 (default; its sculling set is the same)")
+    from strapdown.algorithms.velocity import DEFAULT_VELOCITY_SET, VELOCITY_SETS
+
+    p.add_argument("--velocity-set", choices=VELOCITY_SETS, default=None,
+                   help="nav only: the conventional structure's sculling pairs, as "
+                   f"navigate(velocity_set=...) (default: {DEFAULT_VELOCITY_SET}, what "
+                   "strapdown nav runs; classical: the sculling target on the pairs with the "
+                   "last subsample; the single chain has one set)")
     p.add_argument("--float", dest="real", choices=REALS, default="double",
                    help="C floating-point type of the state and the arithmetic")
     p.add_argument("--sample-rate-hz", type=float, default=None,
@@ -77,10 +84,14 @@ def run(args: argparse.Namespace) -> int:
                              "sample interval h)")
         e = export_c(args.out, algorithm=args.algorithm, structure=args.structure,
                      subsamples=3 if args.subsamples is None else args.subsamples,
-                     coefficients=args.coefficients, real=args.real, name=args.name)
+                     coefficients=args.coefficients, real=args.real, name=args.name,
+                     **({} if args.velocity_set is None
+                        else {"velocity_set": args.velocity_set}))
         print(_wrote(args.out, e.name))
         print("operations per update: " + ", ".join(f"{k} {v}" for k, v in e.ops.items()))
         return 0
+    if args.velocity_set is not None:
+        raise ValueError(f"--velocity-set belongs to --algorithm nav, not {args.algorithm}")
     fam = family(args.algorithm)
     if args.subsamples is not None and "subsamples" not in fam.options:
         raise ValueError(f"--subsamples does not apply to {args.algorithm} (only rotvec has "

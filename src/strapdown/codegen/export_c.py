@@ -27,6 +27,7 @@ from strapdown.algorithms.family import Family, StructureName
 from strapdown.algorithms.rate import Rk4, WindowedRateFamily
 from strapdown.algorithms.rotvec import Rotvec
 from strapdown.algorithms.spec import REGISTRY, AlgorithmName, AlgorithmSpec, CoefficientName
+from strapdown.algorithms.velocity import DEFAULT_VELOCITY_SET, VelocitySet
 from strapdown.codegen.nav_c import fill_names
 from strapdown.io.files import write_text
 
@@ -182,7 +183,7 @@ def _triple_lines(triples, src, base_expr, real):
 
 def _generate_nav(structure: StructureName, subsamples: int,
                   coefficients: CoefficientName | None, real: CReal,
-                  name: str | None) -> CExport:
+                  name: str | None, velocity_set: VelocitySet) -> CExport:
     """The navigation update (:mod:`strapdown.codegen.nav_c`)."""
     from strapdown.codegen.nav_c import generate_nav
 
@@ -195,21 +196,26 @@ def _generate_nav(structure: StructureName, subsamples: int,
         raise ValueError(f"name must be a C identifier, got {name!r}")
     common = _common("double")
     common = common[:common.index("\n/* phi += c m x (a x b)")]  # nav has no triple terms
-    header, source, ops = generate_nav(structure, subsamples, name, common)
+    header, source, ops = generate_nav(structure, subsamples, name, common, velocity_set)
     return CExport(name, header, source, ops, real)
 
 
 def generate(algorithm: ExportName, *, structure: StructureName = "conventional",
              subsamples: int = 3, coefficients: CoefficientName | None = None,
-             real: CReal = "double", h: float = 1e-4, name: str | None = None) -> CExport:
+             real: CReal = "double", h: float = 1e-4, name: str | None = None,
+             velocity_set: VelocitySet = DEFAULT_VELOCITY_SET) -> CExport:
     """Generate the C for one configuration (see :func:`export_c`).
 
     ``algorithm="nav"``: the navigation update on the WGS-84 Earth with coning and sculling
     compensation (:mod:`strapdown.codegen.nav_c`; its sample interval is an argument of the
-    generated init, ``h`` here is not used).
+    generated init, ``h`` here is not used), with the conventional structure's sculling
+    pairs ``velocity_set`` (the library's default, as ``strapdown nav`` runs; the single
+    chain has one set). The attitude algorithms take no velocity set.
     """
     if algorithm == "nav":
-        return _generate_nav(structure, subsamples, coefficients, real, name)
+        return _generate_nav(structure, subsamples, coefficients, real, name, velocity_set)
+    if velocity_set != DEFAULT_VELOCITY_SET:
+        raise ValueError("--velocity-set belongs to --algorithm nav")
     if algorithm == "ahrs":
         raise ValueError("the AHRS has its own generator: strapdown.codegen.ahrs_c.generate_ahrs")
     if algorithm not in _GENERATORS:

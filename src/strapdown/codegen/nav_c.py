@@ -27,7 +27,13 @@ from strapdown.algorithms import _nav_kernels as nk
 from strapdown.algorithms import tables
 from strapdown.algorithms.coning import coefficient_set
 from strapdown.algorithms.structures import single_chain_coefficients
-from strapdown.algorithms.velocity import NAV_STRUCTURES, sculling_matrix
+from strapdown.algorithms.velocity import (
+    DEFAULT_VELOCITY_SET,
+    NAV_STRUCTURES,
+    VelocitySet,
+    effective_velocity_set,
+    sculling_matrix,
+)
 
 __all__ = ["fill_names", "generate_nav", "nav_ops"]
 
@@ -242,11 +248,14 @@ def _cross_terms(matrix, exact, sym: str, a: str, b: str, out: str, twin: bool) 
     return lines
 
 
-def _conventional(n: int) -> tuple[str, str, dict[str, int]]:
-    """State fields and update of the conventional structure: an update every N samples."""
+def _conventional(n: int, velocity_set: VelocitySet = DEFAULT_VELOCITY_SET
+                  ) -> tuple[str, str, dict[str, int]]:
+    """State fields and update of the conventional structure: an update every N samples,
+    with the sculling pairs of ``velocity_set`` (:func:`~strapdown.algorithms.velocity.
+    sculling_matrix`)."""
     cs = coefficient_set("table3", n)
     kc, kx = cs.matrix.tolist(), cs.exact
-    sx = sculling_matrix(n, exact=True)
+    sx = sculling_matrix(n, exact=True, velocity_set=velocity_set)
     ks = [[float(v) for v in r] for r in sx]
     # the kernel interleaves the coning and sculling terms per pair; they feed different
     # sums, so the order within each sum (i outer, j inner) is what is kept
@@ -361,9 +370,11 @@ def _times(d: dict[str, int], n: int) -> dict[str, int]:
     return {k: v * n for k, v in d.items()}
 
 
-def nav_ops(structure: str, n: int) -> dict[str, int]:
+def nav_ops(structure: str, n: int, velocity_set: VelocitySet = DEFAULT_VELOCITY_SET
+            ) -> dict[str, int]:
     """Operations per update of the generated navigation code."""
-    return (_conventional(n) if structure == "conventional" else _single_chain(n))[2]
+    return (_conventional(n, velocity_set) if structure == "conventional"
+            else _single_chain(n))[2]
 
 
 _API = """
@@ -408,18 +419,34 @@ void NAME_reset(NAME_state *s)
 """
 
 
-def generate_nav(structure: str, n: int, name: str, update_helpers: str) -> tuple[str, str,
-                                                                                  dict[str, int]]:
+def _velocity_note(n: int, velocity_set: VelocitySet) -> str:
+    """The header's line on the sculling coefficients: the classical set's wording wherever
+    the set run is the classical one (the single chain, N ≤ 2), so that code is unchanged."""
+    if (sculling_matrix(n, exact=True, velocity_set=velocity_set)
+            == sculling_matrix(n, exact=True)):
+        return ("sculling coefficients from the designer's sculling target (= the coning set, "
+                "Ignagni 1998).")
+    return (f"sculling coefficients: velocity set {velocity_set}, the designer's coning-force "
+            "target on all pairs\n * (classical sculling and a body coning in a constant "
+            "specific force, both to order 2N).")
+
+
+def generate_nav(structure: str, n: int, name: str, update_helpers: str,
+                 velocity_set: VelocitySet = DEFAULT_VELOCITY_SET
+                 ) -> tuple[str, str, dict[str, int]]:
     """``(header, source, ops)`` of the navigation update (see the module docstring).
 
     ``update_helpers``: the C of ``sd_update`` and ``sd_cross_add`` (shared with the attitude
-    export, :mod:`strapdown.codegen.export_c`).
+    export, :mod:`strapdown.codegen.export_c`). ``velocity_set``: the conventional
+    structure's sculling pairs, as :func:`strapdown.algorithms.navigation.navigate` takes
+    them (the library's default; the single chain has one set).
     """
     if structure not in NAV_STRUCTURES:
         raise ValueError(f"nav supports the structures {', '.join(NAV_STRUCTURES)}, got "
                          f"{structure!r}")
+    velocity_set = effective_velocity_set(structure, velocity_set)  # validates the name
     if structure == "conventional":
-        fields, body, ops = _conventional(n)
+        fields, body, ops = _conventional(n, velocity_set)
         period, counter = f"{n}.0 * h", "count"
         what = f"an update every N = {n} samples"
     else:
@@ -434,7 +461,7 @@ def generate_nav(structure: str, n: int, name: str, update_helpers: str) -> tupl
  * Navigation on the WGS-84 Earth (NED): coning, rotation and sculling compensated body
  * increments ({what}), velocity with Earth rate, transport rate and Somigliana gravity,
  * position by Adams-Moulton quadrature of the Earth rates, attitude q_n_b. Savage (1998b);
- * sculling coefficients from the designer's sculling target (= the coning set, Ignagni 1998).
+ * {_velocity_note(n, velocity_set)}
  * Real type: double. Input: gyro increments (rad), accelerometer increments (m/s).
  * Operations per update: {", ".join(f"{k} {v}" for k, v in ops.items())}.
  */
