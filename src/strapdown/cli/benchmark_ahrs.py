@@ -1,5 +1,6 @@
-"""``strapdown benchmark-ahrs``: our AHRS against VQF and Fusion on BROAD trials, or against
-VQF on the simulated generalisation suite (``--suite generalisation``)."""
+"""``strapdown benchmark-ahrs``: our AHRS against VQF and Fusion on BROAD trials, against VQF
+on the simulated generalisation suite (``--suite generalisation``) or on the OpenAXES robot
+recordings (``--suite openaxes``, 6-axis)."""
 
 from __future__ import annotations
 
@@ -14,8 +15,9 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
     """Register ``benchmark-ahrs`` (its options are added when it is used)."""
     p = subparsers.add_parser(
         "benchmark-ahrs", arguments=_arguments,
-        help="our AHRS against VQF and Fusion on BROAD trials (BROAD's metric), or on "
-        "simulated scenarios with truth (--suite generalisation)",
+        help="our AHRS against VQF and Fusion on BROAD trials (BROAD's metric), on "
+        "simulated scenarios with truth (--suite generalisation) or on the OpenAXES robot "
+        "recordings (--suite openaxes)",
         description="Run strapdown's EKF, the open peers VQF (causal: VQF.updateBatch; "
         "acausal: offlineVQF) and Fusion (pip install 'strapdown[bench]'), and our filter's "
         "gating ablations on every BROAD trial in DIR; write per-trial and mean total, heading "
@@ -23,19 +25,27 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
         "acausal, its throughput, and a bar chart. With --suite generalisation (no DIR): our "
         "filter and VQF, causal and offline, on simulated recordings with exact truth "
         "(pendulums, a turning vehicle, a loitering aircraft, spin-coning, hand-held shaking, "
-        "a steel door frame, stationary rests); prints the per-scenario RMSE table.")
+        "a steel door frame, stationary rests); prints the per-scenario RMSE table. With "
+        "--suite openaxes [DIR]: our filter and VQF's 6-axis filter, causal and offline, on "
+        "every OpenAXES robot recording in DIR (default $STRAPDOWN_OPENAXES), each estimate "
+        "aligned to the reference by a fitted constant world and body rotation; prints the "
+        "per-recording table with the medians.")
     p.set_defaults(handler=run)
     return p
 
 
 def _arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("dir", nargs="?", default=None,
-                   help="directory of BROAD .mat trials (not with --suite generalisation)")
-    p.add_argument("--suite", choices=("broad", "generalisation"), default="broad",
+                   help="directory of BROAD .mat trials, or with --suite openaxes of the "
+                   "OpenAXES motion folders (default $STRAPDOWN_OPENAXES); not with --suite "
+                   "generalisation")
+    p.add_argument("--suite", choices=("broad", "generalisation", "openaxes"), default="broad",
                    help="broad (default): the BROAD trials in DIR; generalisation: the "
-                   "simulated scenarios of strapdown.truth.scenarios (needs no data)")
+                   "simulated scenarios of strapdown.truth.scenarios (needs no data); "
+                   "openaxes: the OpenAXES robot recordings in DIR (6-axis)")
     p.add_argument("--out", default=None, help="output directory (default "
-                   "reports/benchmark-ahrs, or reports/benchmark-ahrs-generalisation)")
+                   "reports/benchmark-ahrs, reports/benchmark-ahrs-generalisation or "
+                   "reports/benchmark-ahrs-openaxes)")
     p.add_argument("--algorithm", default="rate-single",
                    help="our propagation algorithm (a spec, as for strapdown ahrs; BROAD only)")
     p.add_argument("--heading-offset-removed", action="store_true",
@@ -63,11 +73,30 @@ def _generalisation(args: argparse.Namespace) -> int:
     return 0
 
 
+def _openaxes(args: argparse.Namespace) -> int:
+    import os
+
+    from strapdown.apps.ahrs_openaxes import SETTLE_S, openaxes, summary_table
+    from strapdown.io.openaxes import ENV
+
+    directory = args.dir if args.dir is not None else os.environ.get(ENV, "")
+    out = args.out or "reports/benchmark-ahrs-openaxes"
+    results, suspects = openaxes(directory, out, progress=say if progress(args) else None)
+    print(summary_table(results, suspects), end="")
+    print(f"cells: total / inclination RMSE (°) after fitting a constant world and body "
+          f"rotation to each estimate, from {SETTLE_S:g} s on; ratios: ours / VQF of the same "
+          "kind, total / inclination (median rows: ratio of the medians)")
+    print(f"wrote {out}/report.md")
+    return 0
+
+
 def run(args: argparse.Namespace) -> int:
     """Run the benchmark and print each filter's mean RMSE and throughput (BROAD) or the
-    per-scenario table (generalisation)."""
+    per-scenario (generalisation) or per-recording (openaxes) table."""
     if args.suite == "generalisation":
         return _generalisation(args)
+    if args.suite == "openaxes":
+        return _openaxes(args)
     from strapdown.apps.ahrs_benchmark import FILTERS, KIND, benchmark, mean_of
 
     out = args.out or "reports/benchmark-ahrs"
