@@ -1,9 +1,10 @@
 """The OpenAXES robot recordings as a benchmark: our AHRS and VQF's 6-axis filter.
 
 Data: Webering, Fahnemann & Stanislawski (2023), the OpenAXES example robot data set, as
-re-packaged (synchronised to the reference) with the RING paper's supplementary material
-(:mod:`strapdown.io.openaxes`): an industrial robot moves two IMUs along circles and
-triangles at four speeds, 125 Hz, no magnetometer. On every recording, from the same arrays:
+re-packaged (synchronised to the reference) with the supplementary material of Bachhuber
+et al. (2024), RING (:mod:`strapdown.io.openaxes`): an industrial robot moves two IMUs along
+circles and triangles at four speeds, 125 Hz, no magnetometer. On every recording, from the
+same arrays:
 
 - ``strapdown EKF`` (causal) and ``strapdown EKF offline`` (acausal):
   :func:`strapdown.ahrs.ekf` and :func:`strapdown.ahrs.offline_ekf` with their defaults,
@@ -201,9 +202,10 @@ def openaxes(directory: str | os.PathLike[str], out: str | os.PathLike[str], *,
     missing = [f for f in FILTERS if _available(f) is not None]
     md = ["# AHRS on the OpenAXES robot recordings (6-axis)\n\n",
           f"Data: {Path(directory)} — Webering, Fahnemann & Stanislawski (2023), OpenAXES "
-          "example robot data set, as re-packaged with the RING paper's supplementary "
-          "material; 125 Hz, no magnetometer. Metric: a constant world and a constant body "
-          "rotation fitted to each estimate (least squares, the same for every filter), then "
+          "example robot data set, as re-packaged with the supplementary material of "
+          "Bachhuber et al. (2024), RING; 125 Hz, no magnetometer. Metric: a constant world "
+          "and a constant body rotation fitted to each estimate (least squares, the same for "
+          "every filter), then "
           f"total / inclination RMSE (degrees) from {SETTLE_S:g} s on. Ratios: ours over the "
           "VQF of the same kind (median rows: ratio of the medians).\n\n"]
     if missing:

@@ -1,5 +1,6 @@
 """OpenAXES robot recordings (Webering, Fahnemann & Stanislawski (2023), as re-packaged
-with the RING paper's supplementary material, synchronised to the reference).
+with the supplementary material of Bachhuber et al. (2024), RING, synchronised to the
+reference).
 
 An industrial robot moves two 6-axis IMUs, on its "carpus" and "radius" links, along
 circles and triangles at four speed settings. A directory of the data set holds one folder
