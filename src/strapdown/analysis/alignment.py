@@ -196,7 +196,7 @@ def _gradient(qe, qr, q_w, q_b):
 
 def _newton(qe, qr, q_w, q_b, tol: float, max_iter: int):
     """Newton on ``Σ ‖ρ‖²`` over ``x = (a, b)`` (module docstring): the gradient analytic,
-    the Hessian by central differences of it (:data:`_FD_STEP` rad), its eigenvalues taken
+    the Hessian by central differences of it (``_FD_STEP`` rad), its eigenvalues taken
     by magnitude (a saddle is left along its negative curvature); the step from the
     pseudo-inverse (flat directions dropped), halved until the cost does not rise; until a
     step is at most ``tol`` rad.
