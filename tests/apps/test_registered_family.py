@@ -5,7 +5,8 @@ A throw-away rate family — the one-sample rectangle rule ``ΔΦ = td ω_k``, n
 plug-in script (:func:`strapdown.algorithms.spec.register`) before the command line runs, in
 a subprocess so the registry of this test session stays as shipped. Each command must then
 list it, run it and write its result: ``evaluate``, ``run``, ``compare``, ``sweep``,
-``advise``, the AHRS's propagation (``ahrs``) and ``export-c``.
+``advise``, the AHRS's propagation (``ahrs``), ``export-c`` and the navigation (``nav
+--algorithm``, through the family's velocity counterpart).
 """
 
 from __future__ import annotations
@@ -130,8 +131,24 @@ def test_export_c_generates_it(plugin):
     assert "rect" in source and "sd_rect_test_conventional_update" in source
 
 
-@pytest.mark.skip(reason="the velocity/navigation path is not yet part of the Family "
-                  "contract (issue 26: spec.velocity(), nav --rates with every rate family); "
-                  "to be added with the navigation/ subpackage")
-def test_nav_navigates_with_it(plugin):  # pragma: no cover - enabled with the nav contract
-    _cli(plugin, "nav", "--help")
+def test_nav_navigates_with_it(plugin):
+    """Its velocity counterpart (the windowed dual, asked of the family) navigates a rate log:
+    listed by nav --algorithm, one update per sample, its own increments."""
+    _, d = plugin
+    assert NAME in _cli(plugin, "nav", "--help").stdout
+    t = np.arange(401) / 200.0
+    w = np.column_stack([0.2 * np.cos(2 * np.pi * t), 0.2 * np.sin(2 * np.pi * t),
+                         np.full_like(t, 0.05)])
+    f = np.tile([0.0, 0.0, -9.81], (t.size, 1))
+    np.savetxt(d / "nav.csv", np.column_stack([t, w, f]), delimiter=",", comments="",
+               header="t,gx[rad/s],gy[rad/s],gz[rad/s],ax[m/s^2],ay[m/s^2],az[m/s^2]",
+               fmt="%.17g")
+    for alg in (NAME, "rate-single"):
+        _cli(plugin, "nav", "--imu", "nav.csv", "--algorithm", alg, "--init-lat", "45",
+             "--init-lon", "7", "--init-height", "300", "--no-progress", "--out",
+             f"nav-{alg}.csv")
+    meta = json.loads((d / f"nav-{NAME}.csv.meta.json").read_text())
+    assert meta["algorithm"] == NAME and meta["outputs"] == 400  # an update every sample
+    rows = np.loadtxt(d / f"nav-{NAME}.csv", delimiter=",", skiprows=1)
+    assert rows.shape[0] == 401 and np.all(np.isfinite(rows))
+    assert (d / f"nav-{NAME}.csv").read_text() != (d / "nav-rate-single.csv").read_text()

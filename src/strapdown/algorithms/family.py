@@ -3,8 +3,9 @@
 An *algorithm family* (``rotvec``, ``rate-three``, ``miller`` …) is one object that knows
 everything the library needs about its algorithm: input kind, update structures,
 coefficient choices, options, minimum samples, update period, classical-coning drift law,
-how to run it (float64 and arbitrary precision) and what the AHRS propagation and the C
-exporter need. Each family lives beside its implementation (:mod:`.rotvec`, :mod:`.rate`,
+how to run it (float64 and arbitrary precision), its velocity counterpart (what the
+navigation runs, :meth:`Family.velocity`) and what the AHRS propagation and the C exporter
+need. Each family lives beside its implementation (:mod:`.rotvec`, :mod:`.rate`,
 :mod:`.quaternion`); :mod:`.spec` collects them into the registry. A configured algorithm
 is an :class:`~strapdown.algorithms.spec.AlgorithmSpec`.
 """
@@ -24,6 +25,7 @@ if TYPE_CHECKING:
     from strapdown.algorithms.precision import MpSolution
     from strapdown.algorithms.spec import AlgorithmSpec
     from strapdown.algorithms.structures import AttitudeSolution
+    from strapdown.algorithms.velocity import VelocitySet, VelocityUpdate
     from strapdown.truth.motions import Motion
 
 __all__ = [
@@ -154,6 +156,19 @@ class Family:
         """Whether the configuration has a drift term of third order in the coning amplitude
         (which a second-order spectral prediction leaves out; ``advise`` says so)."""
         return False
+
+    def velocity(self, spec: AlgorithmSpec, *, velocity_set: VelocitySet | None = None,
+                 sculling: bool = True) -> VelocityUpdate | None:
+        """The velocity counterpart of the configuration (sculling and scrolling beside its
+        coning update), or None where it has none: what the navigation runs
+        (:func:`strapdown.algorithms.velocity.velocity_update`: the N-subsample update for a
+        family of designed coning sets in a structure that runs velocity, the windowed dual
+        for a windowed rate family). ``velocity_set``: the conventional structure's sculling
+        pairs (default :data:`~strapdown.algorithms.velocity.DEFAULT_VELOCITY_SET`)."""
+        from strapdown.algorithms.velocity import DEFAULT_VELOCITY_SET, velocity_update
+
+        return velocity_update(self, spec, velocity_set=velocity_set or DEFAULT_VELOCITY_SET,
+                               sculling=sculling)
 
     def propagation(self, spec: AlgorithmSpec) -> dict[str, Any]:
         """Arguments of the AHRS kernel's propagation step (see :mod:`strapdown.ahrs`)."""

@@ -58,6 +58,7 @@ from strapdown._core.validation import as_quaternions, as_vectors, finite_array
 from strapdown.algorithms import _nav_kernels
 from strapdown.algorithms.velocity import (
     DEFAULT_VELOCITY_SET,
+    BodyIncrements,
     NavStructure,
     VelocitySet,
     body_increments,
@@ -65,7 +66,8 @@ from strapdown.algorithms.velocity import (
 from strapdown.truth.earth import GRAVITY_MODELS, GravityModel, gravity_quadratic
 
 __all__ = ["GRAVITY_MODELS", "POLE_LIMIT_DEG", "TRAILING_POLICIES", "GravityModel",
-           "NavSolution", "NavStream", "TrailingPolicy", "TrailingSamplesWarning", "navigate"]
+           "NavSolution", "NavStream", "TrailingPolicy", "TrailingSamplesWarning", "navigate",
+           "navigate_rates"]
 
 #: What :func:`navigate` does with fewer than N increments left after the last whole
 #: conventional update: navigate without them and warn (``"drop"``), or refuse (``"error"``).
@@ -184,6 +186,61 @@ def navigate(gyro: ArrayLike, accel: ArrayLike, n: int, *, h: float, lat: float,
     t = float(finite_array(t0, "t0")) + np.arange(m + 1) * b.update_period
     _check_pole(t, pos[:, 0])
     return NavSolution(t, pos[:, 0], pos[:, 1], pos[:, 2], v, q, structure, b.n,
+                       b.update_period)
+
+
+def navigate_rates(omega: ArrayLike, force: ArrayLike, *, td: float, lat: float, lon: float,
+                   height: float, algorithm: str = "rate-single",
+                   coefficients: str | None = None, v0: ArrayLike | None = None,
+                   q0: ArrayLike | None = None, t0: float = 0.0, sculling: bool = True,
+                   gravity: GravityModel = "wgs84") -> NavSolution:
+    """Navigate from rate (rad/s) and specific-force (m/s²) samples every ``td`` with the
+    velocity counterpart of a rate-input family (:meth:`strapdown.algorithms.family.Family.
+    velocity`; :func:`strapdown.algorithms.velocity.rate_velocity_algorithms` lists them).
+
+    Sample ``k`` is taken at ``t0 + k td``; the family's window turns them into rotation,
+    velocity and position increments per update (the dual of its coning update), which the
+    Earth navigation of :func:`navigate` integrates. Row 0 is the initial state at the first
+    update's start (``t0`` plus the window's history); a tail too short for one more update is
+    not used.
+
+    Parameters
+    ----------
+    omega, force : array_like of shape (k, 3)
+    td : float
+        Sample interval (s).
+    lat, lon, height, v0, q0, t0, sculling, gravity
+        As :func:`navigate`.
+    algorithm : str
+        A registered rate-input family with a velocity counterpart.
+    coefficients : str, optional
+        Its coefficient set (default: the family's).
+    """
+    from strapdown.algorithms.velocity import _inputs, _rate_spec
+
+    spec = _rate_spec(coefficients, algorithm)
+    vel = spec.family.velocity(spec, sculling=sculling)
+    assert vel is not None  # _rate_spec: a rate-input velocity counterpart
+    w, f = _inputs(omega, force)
+    if w.shape[0] < vel.min_samples:
+        raise ValueError(f"{algorithm} needs at least {vel.min_samples} samples, got "
+                         f"{w.shape[0]}")
+    lat, lon, height, v0, q0 = _initial(lat, lon, height, v0, q0)
+    b = vel.body(w, f, float(finite_array(td, "td (sample interval)")))
+    return _earth(b, lat, lon, height, v0, q0,
+                  float(finite_array(t0, "t0")) + vel.start * b.h, gravity)
+
+
+def _earth(b: BodyIncrements, lat: float, lon: float, height: float, v0, q0, t0: float,
+           gravity: GravityModel) -> NavSolution:
+    """The Earth navigation of body increments from validated initial state at ``t0``."""
+    m = b.phi.shape[0]
+    pos, v, q = np.empty((m + 1, 3)), np.empty((m + 1, 3)), np.empty((m + 1, 4))
+    _nav_kernels.earth_nav_kernel(b.phi, b.dv, b.update_period, lat, lon, height, v0, q0,
+                                  pos, v, q, gravity_quadratic(gravity))
+    t = t0 + np.arange(m + 1) * b.update_period
+    _check_pole(t, pos[:, 0])
+    return NavSolution(t, pos[:, 0], pos[:, 1], pos[:, 2], v, q, b.structure, b.n,
                        b.update_period)
 
 

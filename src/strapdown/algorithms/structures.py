@@ -100,6 +100,9 @@ class UpdateStructure(str):
     runs_increments : bool
         It chains N-subsample coefficient sets on increments (:meth:`run`); the sliding
         structure belongs to the windowed rate algorithms instead.
+    runs_velocity : bool
+        The velocity and position algorithms run in it (the coning, sculling and scrolling
+        update of :mod:`strapdown.algorithms.velocity` and the navigation on it).
     description : str
         One line for help texts.
     """
@@ -110,6 +113,7 @@ class UpdateStructure(str):
     own_startup: bool = False
     pair_only: bool = False
     runs_increments: bool = True
+    runs_velocity: bool = False
     description: str = ""
 
     def __new__(cls, name: str) -> UpdateStructure:
@@ -172,6 +176,7 @@ class UpdateStructure(str):
 
 class _Conventional(UpdateStructure):
     whole_updates = True
+    runs_velocity = True
     description = "an update every N samples (T = N h)"
 
     def run(self, increments, coefficients, *, h=None, t0=None, q0=None):
@@ -195,6 +200,7 @@ class _Realtime(UpdateStructure):
 class _SingleChain(UpdateStructure):
     every_sample = True
     own_startup = True
+    runs_velocity = True
     description = "the designer's single chain: an output every h with N-subsample accuracy"
     #: The sets it takes (the designer's), with the subsamples and triple terms each runs.
     _SETS: ClassVar[dict[str, tuple[bool, bool]]] = {  # name: (plain sum, triple terms)

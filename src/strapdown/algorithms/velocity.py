@@ -65,7 +65,7 @@ from __future__ import annotations
 import itertools
 from dataclasses import dataclass
 from fractions import Fraction
-from typing import Literal, get_args
+from typing import TYPE_CHECKING, Literal, get_args
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -74,7 +74,17 @@ from strapdown._core.validation import as_quaternions, as_vectors, finite_array,
 from strapdown._core.validation import positive_int as _positive_int
 from strapdown.algorithms import _nav_kernels, tables
 from strapdown.algorithms.coning import MAX_SUBSAMPLES, coefficient_set
-from strapdown.algorithms.structures import single_chain_table
+from strapdown.algorithms.structures import UpdateStructure, single_chain_table
+
+if TYPE_CHECKING:
+    from strapdown._core.kinds import InputKind
+    from strapdown.algorithms.coning import WindowedAlgorithm
+    from strapdown.algorithms.family import Family
+    from strapdown.algorithms.spec import AlgorithmSpec
+
+    #: The rate-input velocity algorithms (:func:`rate_velocity_algorithms`, read from the
+    #: registry when asked: module ``__getattr__``).
+    RATE_VELOCITY_ALGORITHMS: tuple[str, ...]
 
 __all__ = [
     "DEFAULT_VELOCITY_SET",
@@ -294,6 +304,146 @@ def body_increments(gyro: ArrayLike, accel: ArrayLike, n: int, *, h: float,
     return BodyIncrements(out[0], out[1], out[2], h, h, structure, n)
 
 
+class VelocityUpdate:
+    """The velocity counterpart of a configured attitude algorithm (what
+    :meth:`strapdown.algorithms.family.Family.velocity` answers): how its samples become
+    body-frame rotation, velocity and position increments per update (module docstring).
+
+    Attributes
+    ----------
+    input_kind : {"increment", "rate"}
+        Increments (rad, m/s) or rate and specific-force samples (rad/s, m/s²).
+    structure : UpdateStructure
+        The update structure of the increments it gives (``BodyIncrements.structure``).
+    n : int
+        Samples per update (conventional) or the single chain's N.
+    min_samples : int
+        Fewest input samples that give one update.
+    start : int
+        Input samples before the first update's start (a window's history): the initial
+        state belongs to sample ``start``.
+    """
+
+    input_kind: InputKind
+    structure: UpdateStructure
+    n: int
+    min_samples: int
+    start: int = 0
+
+    def update_period(self, h: float) -> float:
+        """Time between updates for samples every ``h`` seconds."""
+        return self.structure.update_period(self.n, h)
+
+    def body(self, gyro: NDArray[np.float64], accel: NDArray[np.float64],
+             h: float) -> BodyIncrements:
+        """Body increments of validated ``(k, 3)`` samples every ``h``."""
+        raise NotImplementedError
+
+
+class IncrementVelocity(VelocityUpdate):
+    """The N-subsample coning, sculling and scrolling update on increments
+    (:func:`body_increments`) in a structure that runs it (``UpdateStructure.runs_velocity``).
+    """
+
+    input_kind = "increment"
+
+    def __init__(self, structure: UpdateStructure, n: int, *,
+                 velocity_set: VelocitySet = DEFAULT_VELOCITY_SET, sculling: bool = True):
+        if not structure.runs_velocity:
+            raise ValueError(f"the velocity algorithms run in the "
+                             f"{' or '.join(nav_structures())} structure, not {structure}")
+        self.structure, self.n = structure, _n(n)
+        self.velocity_set, self.sculling = _velocity_set(velocity_set), bool(sculling)
+        self.min_samples = structure.min_increments(self.n)
+
+    def body(self, gyro, accel, h):
+        return body_increments(gyro, accel, self.n, h=h, structure=self.structure,
+                               sculling=self.sculling, velocity_set=self.velocity_set)
+
+
+class WindowedRateVelocity(VelocityUpdate):
+    """The dual of a windowed rate algorithm (module docstring, rate input): its quadrature
+    weights on ω and f give ``α`` and ``υ``, its pair coefficients ``c_p`` both the coning
+    term ``td² Σ c_p ω_i × ω_j`` and the sculling term ``td² Σ c_p (ω_i × f_j + f_i × ω_j)``
+    (Ignagni's duality); ``ΔR_b = ½ T Δv_b``. An update every ``update`` samples, a single
+    chain when that is one."""
+
+    input_kind = "rate"
+
+    def __init__(self, windowed: WindowedAlgorithm, *, sculling: bool = True):
+        from strapdown.algorithms.structures import structure
+
+        self.windowed, self.sculling = windowed, bool(sculling)
+        self.n = windowed.update
+        self.structure = structure("single-chain" if windowed.update == 1 else "conventional")
+        self.start = windowed.history
+        self.min_samples = windowed.history + windowed.span + 1
+
+    def _pairs(self, ws, fs, td: float):
+        """The coning and sculling pair sums (one pair: ``c td td`` first, as
+        ``rate-single`` always computed it; zeros without pairs)."""
+        w = self.windowed
+        k = [float(c) for c in w.pair_coefficients]
+        if not k:
+            return np.zeros_like(ws[0]), np.zeros_like(ws[0])
+        if len(k) == 1:
+            (i, j), c = w.pairs[0], k[0]
+            return (c * td * td * np.cross(ws[i], ws[j]),
+                    c * td * td * (np.cross(ws[i], fs[j]) + np.cross(fs[i], ws[j])))
+        beta = td * td * sum(kk * np.cross(ws[i], ws[j]) for kk, (i, j) in zip(k, w.pairs,
+                                                                                 strict=True))
+        scul = td * td * sum(kk * (np.cross(ws[i], fs[j]) + np.cross(fs[i], ws[j]))
+                             for kk, (i, j) in zip(k, w.pairs, strict=True))
+        return beta, scul
+
+    def body(self, gyro, accel, h):
+        w = self.windowed
+        m = (gyro.shape[0] - self.min_samples) // w.update + 1
+        starts = w.history + w.update * np.arange(m)
+        ws = [gyro[starts + o] for o in w.offsets]
+        fs = [accel[starts + o] for o in w.offsets]
+        wts = [float(x) for x in w.weights]
+        th = h * sum(c * x for c, x in zip(wts, ws, strict=True))
+        ups = h * sum(c * x for c, x in zip(wts, fs, strict=True))
+        beta, scul = self._pairs(ws, fs, h)
+        phi = th + beta if w.pairs else th
+        dv = ups + 0.5 * np.cross(th, ups) + np.cross(th, np.cross(th, ups)) / 6.0
+        if self.sculling:
+            dv = dv + scul
+        period = self.update_period(h)
+        return BodyIncrements(np.ascontiguousarray(phi), np.ascontiguousarray(dv),
+                              np.ascontiguousarray(0.5 * period * dv), h, period,
+                              self.structure, self.n)
+
+
+def velocity_update(family: Family, spec: AlgorithmSpec, *,
+                    velocity_set: VelocitySet = DEFAULT_VELOCITY_SET,
+                    sculling: bool = True) -> VelocityUpdate | None:
+    """The velocity counterpart of ``spec`` (:meth:`Family.velocity`), or None: the N-subsample
+    update for a family running the designed N-subsample coning sets in a structure that runs
+    velocity, the windowed dual for a windowed rate family (not interleaved)."""
+    s = spec.update_structure
+    if family.input_kind == "increment":
+        if not (family.coning_sets and s.runs_velocity and spec.coefficients in (
+                None, family.default_coefficients)):
+            return None
+        return IncrementVelocity(s, spec.subsamples, velocity_set=velocity_set,
+                                 sculling=sculling)
+    windowed = getattr(family, "windowed", None)
+    if windowed is None or s.interleaved:
+        return None
+    return WindowedRateVelocity(windowed(spec), sculling=sculling)
+
+
+def nav_structures() -> tuple[NavStructure, ...]:
+    """The registered update structures the velocity algorithms run in
+    (``UpdateStructure.runs_velocity``), in registry order."""
+    from strapdown.algorithms.structures import STRUCTURE_REGISTRY
+
+    return tuple(s for s in STRUCTURE_REGISTRY.values()  # type: ignore[misc]
+                 if s.runs_velocity)
+
+
 @dataclass(frozen=True)
 class InertialSolution:
     """Attitude, velocity and position in a non-rotating frame without gravity.
@@ -425,40 +575,54 @@ def integrate_inertial_mp(motion, n: int, *, h: float, samples: int, digits: int
                               min(startup, len(t) - 1))
 
 
-#: The rate-input velocity algorithms: the duals of the rate-input coning algorithms of
-#: :mod:`strapdown.algorithms.rate` (module docstring).
-RATE_VELOCITY_ALGORITHMS = ("rate-single", "rate-three")
+def rate_velocity_algorithms() -> tuple[str, ...]:
+    """The registered rate-input families with a velocity counterpart (in registry order):
+    the duals of the rate-input coning algorithms (module docstring), asked of each family
+    (:meth:`strapdown.algorithms.family.Family.velocity`), so a newly registered one is
+    included."""
+    from strapdown.algorithms.spec import REGISTRY, AlgorithmSpec
+
+    return tuple(name for name, fam in REGISTRY.items() if fam.input_kind == "rate"
+                 and fam.velocity(AlgorithmSpec(name)) is not None)
+
+
+def __getattr__(name: str) -> object:
+    # RATE_VELOCITY_ALGORITHMS and NAV_STRUCTURES are read from the registries when asked,
+    # so a family or structure registered after this module's import is in them
+    if name == "RATE_VELOCITY_ALGORITHMS":
+        return rate_velocity_algorithms()
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def _rate_spec(coefficients: str | None, algorithm: str):
+    """The spec of a rate-input velocity algorithm (``coefficients`` None: the family's
+    default), or the error naming those there are."""
+    from strapdown.algorithms.spec import REGISTRY, AlgorithmSpec
+
+    fam = REGISTRY.get(algorithm)  # type: ignore[call-overload]
+    vel = None
+    if fam is not None and fam.input_kind == "rate":
+        vel = fam.velocity(AlgorithmSpec(algorithm))  # type: ignore[arg-type]
+    if vel is None:
+        raise ValueError(f"unknown rate-input velocity algorithm {algorithm!r}; choose one of "
+                         f"{', '.join(rate_velocity_algorithms())}")
+    if coefficients is None:
+        return AlgorithmSpec(algorithm)  # type: ignore[arg-type]
+    if coefficients not in fam.coefficient_names():
+        raise ValueError(f"unknown rate-input coefficients {coefficients!r}; choose one of "
+                         f"{', '.join(fam.coefficient_names())}")
+    return AlgorithmSpec(algorithm, coefficients=coefficients)  # type: ignore[arg-type]
 
 
 def rate_sculling_law(coefficients: str = "derived", algorithm: str = "rate-single"
                       ) -> ScullingLaw:
     """Classical-sculling law of the rate-input update (module docstring), ``h`` = ``td``:
     the coning law of the same rate algorithm with the same coefficients (the duality)."""
-    laws = {"rate-single": tables.RATE_SINGLE_DRIFT, "rate-three": tables.RATE_THREE_DRIFT}
-    if algorithm not in laws:
-        raise ValueError(f"unknown rate-input velocity algorithm {algorithm!r}; choose one of "
-                         f"{', '.join(RATE_VELOCITY_ALGORITHMS)}")
-    if coefficients not in laws[algorithm]:
-        raise ValueError(f"unknown rate-input coefficients {coefficients!r}; choose one of "
-                         f"{', '.join(laws[algorithm])}")
-    order, c = laws[algorithm][coefficients]
-    return ScullingLaw(order, c)
-
-
-def _rate_three_body(w, f, td: float, coefficients: str):
-    """Body increments of the three-period dual (an update every 3 td, samples 0 … 3m)."""
-    m = (w.shape[0] - 1) // 3
-    ws = [w[j: 3 * m + j: 3][:m] for j in range(4)]
-    fs = [f[j: 3 * m + j: 3][:m] for j in range(4)]
-    wts = [float(x) for x in tables.RATE_THREE_WEIGHTS]
-    alpha = td * sum(c * x for c, x in zip(wts, ws, strict=True))
-    ups = td * sum(c * x for c, x in zip(wts, fs, strict=True))
-    k = [float(x) for x in tables.RATE_THREE[coefficients]]  # type: ignore[index]
-    pairs = tables.RATE_THREE_PAIRS
-    beta = td * td * sum(kk * np.cross(ws[i], ws[j]) for kk, (i, j) in zip(k, pairs, strict=True))
-    scul = td * td * sum(kk * (np.cross(ws[i], fs[j]) + np.cross(fs[i], ws[j]))
-                         for kk, (i, j) in zip(k, pairs, strict=True))
-    return alpha, ups, alpha + beta, scul
+    spec = _rate_spec(coefficients, algorithm)
+    law = spec.family.drift_law(spec)
+    if law is None:
+        raise ValueError(f"{algorithm} has no known sculling law (its coning law is unknown)")
+    return ScullingLaw(law.order, law.constant)
 
 
 def integrate_inertial_rates(omega: ArrayLike, force: ArrayLike, *, td: float,
@@ -487,27 +651,17 @@ def integrate_inertial_rates(omega: ArrayLike, force: ArrayLike, *, td: float,
     sample interval, ``n`` 1) and ``"conventional"`` for rate-three (``n`` 3).
     """
     w, f = _inputs(omega, force)
-    rate_sculling_law(coefficients, algorithm)  # validates both names
-    need = 2 if algorithm == "rate-single" else 4
-    if w.shape[0] < need:
-        raise ValueError(f"{algorithm} needs at least {need} samples, got {w.shape[0]}")
+    spec = _rate_spec(coefficients, algorithm)
+    vel = spec.family.velocity(spec)
+    assert vel is not None  # _rate_spec: a velocity counterpart
+    if w.shape[0] < vel.min_samples:
+        raise ValueError(f"{algorithm} needs at least {vel.min_samples} samples, got "
+                         f"{w.shape[0]}")
     td = positive(td, "td (sample interval)")
     q0, v0, p0 = _state(q0, v0, p0)
-    if algorithm == "rate-single":
-        c = float(tables.RATE_SINGLE[coefficients])  # type: ignore[index]
-        w0, w1, f0, f1 = w[:-1], w[1:], f[:-1], f[1:]
-        th, ups = 0.5 * td * (w0 + w1), 0.5 * td * (f0 + f1)
-        phi = th + c * td * td * np.cross(w0, w1)
-        scul = c * td * td * (np.cross(w0, f1) + np.cross(f0, w1))
-        period, n, structure = td, 1, "single-chain"
-    else:
-        th, ups, phi, scul = _rate_three_body(w, f, td, coefficients)
-        period, n, structure = 3 * td, 3, "conventional"
-    dv = ups + 0.5 * np.cross(th, ups) + np.cross(th, np.cross(th, ups)) / 6.0 + scul
-    dr = 0.5 * period * dv
-    m = phi.shape[0]
+    b = vel.body(w, f, td)
+    m = b.phi.shape[0]
     q, v, p = np.empty((m + 1, 4)), np.empty((m + 1, 3)), np.empty((m + 1, 3))
-    _nav_kernels.inertial_kernel(np.ascontiguousarray(phi), np.ascontiguousarray(dv),
-                                 np.ascontiguousarray(dr), period, q0, v0, p0, q, v, p)
-    t = float(finite_array(t0, "t0")) + np.arange(m + 1) * period
-    return InertialSolution(t, q, v, p, structure, n, td, period, 0)  # type: ignore[arg-type]
+    _nav_kernels.inertial_kernel(b.phi, b.dv, b.dr, b.update_period, q0, v0, p0, q, v, p)
+    t = float(finite_array(t0, "t0")) + vel.start * td + np.arange(m + 1) * b.update_period
+    return InertialSolution(t, q, v, p, b.structure, b.n, td, b.update_period, 0)

@@ -42,7 +42,6 @@ from numpy.typing import NDArray
 from strapdown._core.errors import InputError
 from strapdown.algorithms.velocity import (
     NAV_STRUCTURES,
-    RATE_VELOCITY_ALGORITHMS,
     NavStructure,
     coning_force_law,
     effective_velocity_set,
@@ -50,6 +49,7 @@ from strapdown.algorithms.velocity import (
     integrate_inertial_mp,
     integrate_inertial_rates,
     rate_sculling_law,
+    rate_velocity_algorithms,
     sculling_law,
 )
 from strapdown.analysis.accuracy import drift_rate
@@ -83,12 +83,13 @@ def validate_sculling(cfg: EvaluationConfig) -> None:
     at most :data:`MAX_MP_SCULLING_SAMPLES` samples."""
     from strapdown.algorithms.coning import MAX_SUBSAMPLES
 
-    if cfg.algorithm in RATE_VELOCITY_ALGORITHMS:
+    if cfg.algorithm in rate_velocity_algorithms():
         _validate_rate(cfg)
     elif cfg.algorithm != "rotvec":
         raise InputError(f"the sculling motion runs the velocity algorithms (rotvec, N = 1–"
-                         f"{MAX_SUBSAMPLES}; rate input: {', '.join(RATE_VELOCITY_ALGORITHMS)}"
-                         f"); {cfg.algorithm} integrates attitude only")
+                         f"{MAX_SUBSAMPLES}; rate input: "
+                         f"{', '.join(rate_velocity_algorithms())}); {cfg.algorithm} "
+                         "integrates attitude only")
     elif cfg.structure not in NAV_STRUCTURES:
         raise InputError(f"the velocity algorithms run in the {' or '.join(NAV_STRUCTURES)} "
                          f"structure, not {cfg.structure}")
@@ -198,7 +199,7 @@ def _errors(cfg: EvaluationConfig, motion: ScullingMotion, h: float,
                                    NDArray[np.float64], int, float]:
     """Output times, velocity and position errors, first steady output, update period."""
     structure = cast(NavStructure, cfg.structure)  # validate_sculling: one of NAV_STRUCTURES
-    if cfg.algorithm in RATE_VELOCITY_ALGORITHMS:
+    if cfg.algorithm in rate_velocity_algorithms():
         t_s = np.arange(samples) * h
         sol = integrate_inertial_rates(motion.rate(t_s), motion.specific_force(t_s), td=h,
                                        coefficients=cfg.coefficients or "derived",
@@ -231,7 +232,7 @@ def evaluate_sculling(cfg: EvaluationConfig) -> ScullingEvaluation:
     if np.count_nonzero(sel) < 2:
         sel = np.ones(t.size, dtype=bool)
     est = drift_rate(t[sel], dv[sel], period=vib, reference_time=ref, h=period)
-    rate_input = cfg.algorithm in RATE_VELOCITY_ALGORITHMS
+    rate_input = cfg.algorithm in rate_velocity_algorithms()
     law = (rate_sculling_law(cfg.coefficients or "derived", cfg.algorithm) if rate_input
            else sculling_law(cfg.subsamples)).predict(
         math.radians(cfg.angle_amplitude_deg), cfg.accel_amplitude, math.radians(cfg.phase_deg),

@@ -72,7 +72,12 @@ from tqdm import tqdm
 
 from strapdown._core.errors import InputError
 from strapdown._core.kinds import InputKind
-from strapdown.algorithms.navigation import TRAILING_POLICIES, NavStream, TrailingPolicy
+from strapdown.algorithms.navigation import (
+    TRAILING_POLICIES,
+    NavSolution,
+    NavStream,
+    TrailingPolicy,
+)
 from strapdown.algorithms.rate import JITTER_TOLERANCE as STAMP_TOLERANCE
 from strapdown.algorithms.velocity import NavStructure
 from strapdown.io import read_imu
@@ -474,8 +479,8 @@ def navigate_log(imu: str | os.PathLike[str], out: str | os.PathLike[str], *, la
                  on_gap: NavGapPolicy = "error", timing: TimingMode = "auto",
                  jitter_tolerance: float = JITTER_TOLERANCE, held: HeldPolicy = "auto",
                  duplicates: DuplicatePolicy = "error",
-                 trailing: TrailingPolicy = "drop", gravity: GravityModel = "wgs84"
-                 ) -> dict[str, Any]:
+                 trailing: TrailingPolicy = "drop", gravity: GravityModel = "wgs84",
+                 algorithm: str | None = None) -> dict[str, Any]:
     """Navigate a log and write the initial state and one row per update (see the module
     docstring).
 
@@ -498,6 +503,13 @@ def navigate_log(imu: str | os.PathLike[str], out: str | os.PathLike[str], *, la
         without (counted in the summary; default), or an error naming them.
     gravity : {"wgs84", "linear"}
         Normal gravity's height correction (:func:`strapdown.truth.earth.gravity`).
+    algorithm : str, optional
+        Rate logs only: a registered rate-input family with a velocity counterpart
+        (:func:`strapdown.algorithms.velocity.rate_velocity_algorithms`), whose window turns
+        the rate and specific-force samples into the update's increments
+        (:func:`strapdown.algorithms.navigation.navigate_rates`); ``subsamples`` and
+        ``structure`` are then not used. None (default): the rates are integrated to
+        increments for the N-subsample update.
 
     Returns
     -------
@@ -515,6 +527,9 @@ def navigate_log(imu: str | os.PathLike[str], out: str | os.PathLike[str], *, la
     if gravity not in GRAVITY_MODELS:
         raise InputError(f"gravity must be one of {', '.join(GRAVITY_MODELS)}, got "
                          f"{gravity!r}")
+    if algorithm is not None and kind != "rate":
+        raise InputError("--algorithm names a rate-input velocity algorithm: it navigates rate "
+                         "logs (--rates), not increments")
     lat, lon, hgt, v0, q0 = _initial_state(lat_deg, lon_deg, height, velocity, attitude_deg)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -523,14 +538,24 @@ def navigate_log(imu: str | os.PathLike[str], out: str | os.PathLike[str], *, la
                            unit_check="warn" if accept_unit_warning else "error",
                            on_gap=on_gap, timing=timing, jitter_tolerance=jitter_tolerance,
                            held=held, duplicates=duplicates)
-    if kind == "rate":
-        g, a = increments_from_rates(log.gyro, log.h), increments_from_rates(log.accel, log.h)
-        t0 = float(log.t[0])
+    stream: NavStream | _RateRun
+    if algorithm is not None:
+        stream = _RateRun(log, algorithm, lat=lat, lon=lon, height=hgt, v0=v0, q0=q0,
+                          sculling=sculling, gravity=gravity)
+        g, a, t0, left = log.gyro, log.accel, stream.t0, stream.left
+        if left and trailing == "error":
+            raise InputError(f"the log's {g.shape[0]} samples leave {left} after the last "
+                             f"whole update of {algorithm} (--trailing error); nothing written")
     else:
-        g, a, t0 = log.gyro, log.accel, float(log.t[0]) - log.h
-    stream = NavStream(subsamples, h=log.h, lat=lat, lon=lon, height=hgt, v0=v0, q0=q0,
-                       structure=structure, t0=t0, sculling=sculling, gravity=gravity)
-    left = _trailing(g.shape[0], stream, trailing)
+        if kind == "rate":
+            g, a = (increments_from_rates(log.gyro, log.h),
+                    increments_from_rates(log.accel, log.h))
+            t0 = float(log.t[0])
+        else:
+            g, a, t0 = log.gyro, log.accel, float(log.t[0]) - log.h
+        stream = NavStream(subsamples, h=log.h, lat=lat, lon=lon, height=hgt, v0=v0, q0=q0,
+                           structure=structure, t0=t0, sculling=sculling, gravity=gravity)
+        left = _trailing(g.shape[0], stream, trailing)
     first = _rows(np.array([t0]), np.array([lat]), np.array([lon]), np.array([hgt]),
                   v0[None, :], (q0 / np.linalg.norm(q0))[None, :])  # as navigate's row 0
     from strapdown import __version__
@@ -550,8 +575,47 @@ def navigate_log(imu: str | os.PathLike[str], out: str | os.PathLike[str], *, la
             "on_gap": on_gap, "bridged_samples": log.bridged,
             "timing": None if log.timing is None else log.timing.to_dict(),
             "time_base": None if log.timing is None else log.timing.describe(),
-            "warnings": [str(w.message) for w in caught], "version": __version__}
+            "warnings": [str(w.message) for w in caught], "version": __version__,
+            **({} if algorithm is None else {"algorithm": algorithm})}
     return paired.meta
+
+
+class _RateRun:
+    """A rate log navigated whole by a rate-input family's velocity counterpart
+    (:func:`~strapdown.algorithms.navigation.navigate_rates`), fed as :class:`NavStream` is:
+    its updates come with the first chunk."""
+
+    def __init__(self, log: NavLog, algorithm: str, **kw: Any):
+        from strapdown.algorithms.navigation import navigate_rates
+        from strapdown.algorithms.velocity import _rate_spec
+
+        try:
+            spec = _rate_spec(None, algorithm)
+        except ValueError as e:
+            raise InputError(str(e)) from None
+        vel = spec.family.velocity(spec)
+        assert vel is not None  # _rate_spec: a velocity counterpart
+        k = log.gyro.shape[0]
+        if k < vel.min_samples:
+            raise InputError(f"{algorithm} needs at least {vel.min_samples} samples, the log "
+                             f"has {k}; nothing written")
+        self.h, self.n, self._structure = log.h, vel.n, vel.structure
+        self.update_period = vel.update_period(log.h)
+        self.left = (k - vel.min_samples) % vel.n
+        sol = navigate_rates(log.gyro, log.accel, td=log.h, algorithm=algorithm,
+                             t0=float(log.t[0]), **kw)
+        self._sol: NavSolution | None = sol
+        self.t0 = float(sol.t[0])
+
+    def feed(self, gyro: NDArray[np.float64], accel: NDArray[np.float64]) -> NavSolution:
+        """Every update on the first call, none after."""
+        sol, self._sol = self._sol, None
+        if sol is None:
+            z = np.empty((0, 3))
+            return NavSolution(np.empty(0), z[:, 0], z[:, 0], z[:, 0], z, np.empty((0, 4)),
+                               self._structure, self.n, self.update_period)
+        return NavSolution(sol.t[1:], sol.lat[1:], sol.lon[1:], sol.height[1:], sol.v[1:],
+                           sol.q[1:], sol.structure, sol.n, sol.update_period)
 
 
 def _trailing(k: int, stream: NavStream, policy: TrailingPolicy) -> int:
@@ -568,8 +632,8 @@ def _trailing(k: int, stream: NavStream, policy: TrailingPolicy) -> int:
     return left
 
 
-def _stream_to(out: Path, stream: NavStream, g: NDArray[np.float64], a: NDArray[np.float64],
-               progress: bool, first: NDArray[np.float64]) -> int:
+def _stream_to(out: Path, stream: NavStream | _RateRun, g: NDArray[np.float64],
+               a: NDArray[np.float64], progress: bool, first: NDArray[np.float64]) -> int:
     """Write the initial-state row ``first``, then feed the increments in chunks, writing
     each chunk's rows as they come; returns the number of updates."""
     csv_out = out.suffix.lower() == ".csv"

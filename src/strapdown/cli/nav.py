@@ -41,7 +41,7 @@ def add_parser(subparsers) -> argparse.ArgumentParser:
 
 
 def _arguments(p: argparse.ArgumentParser) -> None:
-    from strapdown.algorithms.velocity import NAV_STRUCTURES
+    from strapdown.algorithms.velocity import NAV_STRUCTURES, rate_velocity_algorithms
     from strapdown.apps.nav import ACC_UNITS, TRAILING_POLICIES
     from strapdown.io.readers import INCREMENT_UNITS, RATE_UNITS
     from strapdown.truth.earth import GRAVITY_MODELS
@@ -95,6 +95,12 @@ def _arguments(p: argparse.ArgumentParser) -> None:
     a.add_argument("--subsamples", type=int, default=3,
                    help="N of the coning and sculling corrections (1-6; default 3, whose "
                    "velocity set also holds on a coning body in gravity)")
+    a.add_argument("--algorithm", choices=rate_velocity_algorithms(), default=None,
+                   help="rate logs only: navigate with this rate-input family's velocity "
+                   "counterpart (the dual of its coning update: its window on the rate and "
+                   "specific-force samples, an update every its period; --structure and "
+                   "--subsamples are then not used). Default: the rates are integrated to "
+                   "increments for the N-subsample update")
     a.add_argument("--no-sculling", dest="sculling", action="store_false",
                    help="drop the sculling correction (rotation compensation only)")
     a.add_argument("--gravity", choices=GRAVITY_MODELS, default="wgs84",
@@ -123,7 +129,7 @@ def run(args: argparse.Namespace) -> int:
                        structure=args.structure, sculling=args.sculling,
                        accept_unit_warning=args.accept_unit_warning, progress=progress(args),
                        on_gap=args.on_gap, trailing=args.trailing, gravity=args.gravity,
-                       **timing_options(args))
+                       algorithm=args.algorithm, **timing_options(args))
     for w in res["warnings"]:
         say(f"warning: {w}")
     if res["trailing_samples_dropped"]:
