@@ -64,28 +64,6 @@ KERNEL_DECORATORS = frozenset({"njit", "jit", "vectorize", "guvectorize", "cfunc
 #: Files outside the model still allowed a rule, relative to ``src/strapdown``, with why.
 #: To be emptied: every entry is work left, not a licence.
 ALLOWED: dict[str, tuple[frozenset[str], str]] = {
-    # --- the navigation wing (issue 26: being reworked by other engineers this session;
-    #     moves into navigation/ with the velocity counterpart of the Family contract)
-    "algorithms/velocity.py": (frozenset({"name-dispatch", "long-function"}),
-                               "navigation wing, issue 26: velocity counterpart of Family"),
-    "algorithms/navigation.py": (frozenset({"name-dispatch", "long-function"}),
-                                 "navigation wing, issue 26"),
-    "algorithms/_nav_reference.py": (frozenset({"name-dispatch", "long-function"}),
-                                     "navigation wing, issue 26"),
-    "algorithms/_nav_kernels.py": (frozenset({"name-dispatch", "long-function"}),
-                                   "navigation wing, issue 26"),
-    "analysis/sculling.py": (frozenset({"name-dispatch", "long-function"}),
-                             "navigation wing, issue 26: re-validates names of the model"),
-    "truth/sculling.py": (frozenset({"name-dispatch", "long-function"}),
-                          "navigation wing, issue 26"),
-    "reproduce/sculling.py": (frozenset({"name-dispatch", "long-function"}),
-                              "navigation wing, issue 26"),
-    "apps/nav.py": (frozenset({"name-dispatch", "long-function"}),
-                    "navigation wing, issue 26"),
-    "cli/nav.py": (frozenset({"name-dispatch", "long-function"}),
-                   "navigation wing, issue 26"),
-    "codegen/nav_c.py": (frozenset({"name-dispatch", "long-function"}),
-                         "navigation wing, issue 26; C templates still in function bodies"),
     # --- the designer (issue 26: coning-in-specific-force target being added)
     "design/designer.py": (frozenset({"name-dispatch", "long-function"}),
                            "designer forms, issue 26 velocity sets in progress"),
@@ -99,8 +77,6 @@ ALLOWED: dict[str, tuple[frozenset[str], str]] = {
     "codegen/export_c.py": (frozenset({"name-dispatch", "long-function"}),
                             "C exporter: structure dispatch and C templates in function "
                             "bodies; the AHRS export is being added beside it"),
-    "cli/export_c.py": (frozenset({"name-dispatch"}),
-                        "export-c's options (the AHRS export is being added to it)"),
 }
 
 

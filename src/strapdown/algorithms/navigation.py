@@ -304,7 +304,7 @@ class NavStream:
         lat, lon, height, v, q = _initial(lat, lon, height, v0, q0)
         self.n, self.h = _n(n), positive(h, "h (sample interval)")
         self.structure, self.sculling = _structure(structure), bool(sculling)
-        self.update_period = self.n * self.h if structure == "conventional" else self.h
+        self.update_period = self.structure.update_period(self.n, self.h)
         self._pos = np.array([lat, lon, height])
         self._v, self._q = v, q
         self._hist = np.zeros((3, 12))  # Earth rates of the last updates (the kernel's)
@@ -319,7 +319,7 @@ class NavStream:
         n = self.n
         g = np.concatenate([self._pending[0], g])
         a = np.concatenate([self._pending[1], a])
-        if self.structure == "conventional":
+        if self.structure.whole_updates:  # the conventional structure: whole updates
             m = g.shape[0] // n
             self._pending = (g[m * n:], a[m * n:])
             g, a = g[: m * n], a[: m * n]
@@ -330,9 +330,9 @@ class NavStream:
             return None
         cg, ca = self._ctx
         b = body_increments(np.concatenate([cg, g]), np.concatenate([ca, a]), n, h=self.h,
-                            structure=self.structure, sculling=self.sculling,
-                            velocity_set=self.velocity_set)
-        skip = cg.shape[0] // (n if self.structure == "conventional" else 1)
+                            structure=self.structure.name,  # type: ignore[arg-type]
+                            sculling=self.sculling, velocity_set=self.velocity_set)
+        skip = cg.shape[0] // (n if self.structure.whole_updates else 1)
         both_g, both_a = np.concatenate([cg, g]), np.concatenate([ca, a])
         start = max(both_g.shape[0] - keep, 0)
         self._ctx = (both_g[start:], both_a[start:]) if keep else (_Z3, _Z3)
@@ -366,4 +366,5 @@ class NavStream:
         _check_pole(t, pos[1:, 0])
         self._updates += m
         return NavSolution(t, pos[1:, 0], pos[1:, 1], pos[1:, 2], v[1:], q[1:],
-                           self.structure, self.n, self.update_period)
+                           self.structure.name,  # type: ignore[arg-type]
+                           self.n, self.update_period)

@@ -74,7 +74,11 @@ from strapdown._core.validation import as_quaternions, as_vectors, finite_array,
 from strapdown._core.validation import positive_int as _positive_int
 from strapdown.algorithms import _nav_kernels, tables
 from strapdown.algorithms.coning import MAX_SUBSAMPLES, coefficient_set
-from strapdown.algorithms.structures import UpdateStructure, single_chain_table
+from strapdown.algorithms.structures import (
+    STRUCTURE_REGISTRY,
+    UpdateStructure,
+    single_chain_table,
+)
 
 if TYPE_CHECKING:
     from strapdown._core.kinds import InputKind
@@ -111,7 +115,13 @@ __all__ = [
 
 #: Update structures of the velocity/position algorithms.
 NavStructure = Literal["conventional", "single-chain"]
-NAV_STRUCTURES: tuple[NavStructure, ...] = get_args(NavStructure)
+#: The registered structures they run in (``UpdateStructure.runs_velocity``; also
+#: :func:`nav_structures`, which sees one registered later), the objects themselves.
+NAV_STRUCTURES: tuple[NavStructure, ...] = tuple(
+    s for s in STRUCTURE_REGISTRY.values() if s.runs_velocity)  # type: ignore[misc]
+if NAV_STRUCTURES != get_args(NavStructure):  # one list of names: the Literal
+    raise RuntimeError(f"the velocity structures {NAV_STRUCTURES} and NavStructure "
+                       f"{get_args(NavStructure)} differ")
 #: The velocity (sculling) sets of the conventional structure (module docstring).
 VelocitySet = Literal["coning-force", "classical"]
 VELOCITY_SETS: tuple[VelocitySet, ...] = get_args(VelocitySet)
@@ -140,11 +150,16 @@ def _n(n: int) -> int:
     return n
 
 
-def _structure(structure: object) -> NavStructure:
-    if structure not in NAV_STRUCTURES:
+def _structure(structure: object) -> UpdateStructure:
+    """The registered structure of that name, if the velocity algorithms run in it
+    (``UpdateStructure.runs_velocity``)."""
+    from strapdown.algorithms.structures import STRUCTURE_REGISTRY
+
+    found = STRUCTURE_REGISTRY.get(structure) if isinstance(structure, str) else None
+    if found is None or not found.runs_velocity:
         raise ValueError(f"unknown velocity structure {structure!r}; choose one of "
-                         f"{', '.join(NAV_STRUCTURES)}")
-    return structure
+                         f"{', '.join(nav_structures())}")
+    return found
 
 
 def _velocity_set(name: object) -> VelocitySet:
@@ -168,12 +183,13 @@ class ConingForceLaw:
         return -float(self.constant) * half_angle**2 * force * (cone_rate * h) ** self.order
 
 
-def effective_velocity_set(structure: NavStructure,
+def effective_velocity_set(structure: NavStructure | UpdateStructure,
                            velocity_set: VelocitySet = DEFAULT_VELOCITY_SET) -> VelocitySet:
     """The set a structure runs for the name given: the single chain has one set, the
     classical one (module docstring)."""
-    return "classical" if _structure(structure) == "single-chain" else _velocity_set(
-        velocity_set)
+    # the structure with its own start-up sets is the single chain: its N − 1 coefficients
+    # are all fixed by the sculling conditions, one set
+    return "classical" if _structure(structure).own_startup else _velocity_set(velocity_set)
 
 
 def coning_force_law(n: int, structure: NavStructure = "conventional",
@@ -192,6 +208,22 @@ def sculling_law(n: int) -> ScullingLaw:
     return ScullingLaw(order, c)
 
 
+def _classical_pairs(n: int) -> list[tuple[tuple[int, int], Fraction]]:
+    """The classical set: the pairs with the last subsample, ``s[N−1−m, N−1] = ς_m``."""
+    return [((n - 1 - m, n - 1), c) for m, c in enumerate(tables.SCULLING_CONVENTIONAL[n],
+                                                          start=1)]
+
+
+def _coning_force_pairs(n: int) -> list[tuple[tuple[int, int], Fraction]]:
+    """The coning-force set: every pair ``i < j``, ``s[i, j] = k_ij``."""
+    pairs = [(i, j) for i in range(n) for j in range(i + 1, n)]
+    return list(zip(pairs, tables.SCULLING_CONING_FORCE[n], strict=True))
+
+
+#: The conventional structure's sculling pairs per velocity set.
+_SCULLING_PAIRS = {"classical": _classical_pairs, "coning-force": _coning_force_pairs}
+
+
 def sculling_matrix(n: int, *, exact: bool = False, velocity_set: VelocitySet = "classical"):
     """``(N, N)`` upper-triangular sculling matrix of the conventional structure:
     ``"classical"``: ``s[N−1−m, N−1] = ς_m`` (cross with the last subsample);
@@ -199,13 +231,8 @@ def sculling_matrix(n: int, *, exact: bool = False, velocity_set: VelocitySet = 
     :class:`~fractions.Fraction`."""
     n = _n(n)
     rows = [[Fraction(0)] * n for _ in range(n)]
-    if _velocity_set(velocity_set) == "coning-force":
-        pairs = [(i, j) for i in range(n) for j in range(i + 1, n)]
-        for (i, j), c in zip(pairs, tables.SCULLING_CONING_FORCE[n], strict=True):
-            rows[i][j] = c
-    else:
-        for m, c in enumerate(tables.SCULLING_CONVENTIONAL[n], start=1):
-            rows[n - 1 - m][n - 1] = c
+    for (i, j), c in _SCULLING_PAIRS[_velocity_set(velocity_set)](n):
+        rows[i][j] = c
     if exact:
         return rows
     return np.array([[float(v) for v in r] for r in rows])
@@ -284,7 +311,8 @@ def body_increments(gyro: ArrayLike, accel: ArrayLike, n: int, *, h: float,
     g, a = _inputs(gyro, accel)
     n, h = _n(n), positive(h, "h (sample interval)")
     velocity_set = _velocity_set(velocity_set)
-    if _structure(structure) == "conventional":
+    st = _structure(structure)
+    if st.whole_updates:  # the conventional structure
         m = g.shape[0] // n
         if m < 1:
             raise ValueError(f"N = {n} needs at least {n} samples, got {g.shape[0]}")
@@ -494,7 +522,7 @@ def integrate_inertial(gyro: ArrayLike, accel: ArrayLike, n: int, *, h: float,
     p = np.empty((m + 1, 3))
     _nav_kernels.inertial_kernel(b.phi, b.dv, b.dr, b.update_period, q0, v0, p0, q, v, p)
     t = t0 + np.arange(m + 1) * b.update_period
-    startup = min(b.n - 1, m) if structure == "single-chain" else 0
+    startup = min(b.n - 1, m) if _structure(b.structure).own_startup else 0
     return InertialSolution(t, q, v, p, structure, b.n, b.h, b.update_period, startup)
 
 
@@ -538,7 +566,7 @@ def integrate_inertial_mp(motion, n: int, *, h: float, samples: int, digits: int
                          f"{MAX_MP_SAMPLES}")
     if digits < 17:
         raise ValueError(f"digits must be at least 17 (float64 is ~16), got {digits}")
-    _structure(structure)
+    st = _structure(structure)
     _velocity_set(velocity_set)
     with mpmath.workdps(digits):
         hm = mpmath.mpf(h)
@@ -550,7 +578,7 @@ def integrate_inertial_mp(motion, n: int, *, h: float, samples: int, digits: int
         def mp(rows):
             return [[mpmath.mpf(v.numerator) / v.denominator for v in r] for r in rows]
 
-        if structure == "conventional":
+        if st.whole_updates:  # the conventional structure
             kc = mp(coefficient_set("table3", n).exact)
             body = ref.conventional_body(g, a, kc, mp(sculling_matrix(
                 n, exact=True, velocity_set=velocity_set)), hm, zero)

@@ -41,13 +41,13 @@ from numpy.typing import NDArray
 
 from strapdown._core.errors import InputError
 from strapdown.algorithms.velocity import (
-    NAV_STRUCTURES,
     NavStructure,
     coning_force_law,
     effective_velocity_set,
     integrate_inertial,
     integrate_inertial_mp,
     integrate_inertial_rates,
+    nav_structures,
     rate_sculling_law,
     rate_velocity_algorithms,
     sculling_law,
@@ -85,20 +85,14 @@ def validate_sculling(cfg: EvaluationConfig) -> None:
 
     if cfg.algorithm in rate_velocity_algorithms():
         _validate_rate(cfg)
-    elif cfg.algorithm != "rotvec":
-        raise InputError(f"the sculling motion runs the velocity algorithms (rotvec, N = 1–"
+    elif cfg.algorithm not in _increment_velocity_algorithms():
+        raise InputError(f"the sculling motion runs the velocity algorithms "
+                         f"({', '.join(_increment_velocity_algorithms())}, N = 1–"
                          f"{MAX_SUBSAMPLES}; rate input: "
                          f"{', '.join(rate_velocity_algorithms())}); {cfg.algorithm} "
                          "integrates attitude only")
-    elif cfg.structure not in NAV_STRUCTURES:
-        raise InputError(f"the velocity algorithms run in the {' or '.join(NAV_STRUCTURES)} "
-                         f"structure, not {cfg.structure}")
-    elif cfg.coefficients not in (None, "table3"):
-        raise InputError(f"the velocity algorithms use the designer's sets (coning: table3); "
-                         f"coefficients {cfg.coefficients} do not apply to the sculling motion")
-    elif not 1 <= cfg.subsamples <= MAX_SUBSAMPLES:
-        raise InputError(f"N (subsamples) must be 1–{MAX_SUBSAMPLES} for the velocity "
-                         f"algorithms, got {cfg.subsamples}")
+    else:
+        _validate_increment_velocity(cfg, "the sculling motion")
     if cfg.gyro is not None and not cfg.gyro.is_ideal:
         raise InputError("the sculling motion takes ideal sensors only (no gyro errors)")
     theta = _finite("angle amplitude (deg)", cfg.angle_amplitude_deg)
@@ -121,15 +115,40 @@ def validate_sculling(cfg: EvaluationConfig) -> None:
                              f"{MAX_MP_SCULLING_SAMPLES} (shorten --duration or lower the rate)")
 
 
+def _increment_velocity_algorithms() -> tuple[str, ...]:
+    """The registered increment families with an N-subsample velocity counterpart (asked of
+    each family: :meth:`~strapdown.algorithms.family.Family.velocity`)."""
+    from strapdown.algorithms.spec import REGISTRY, AlgorithmSpec
+
+    return tuple(name for name, fam in REGISTRY.items()
+                 if fam.input_kind == "increment" and fam.coning_sets
+                 and fam.velocity(AlgorithmSpec(name)) is not None)
+
+
+def _validate_increment_velocity(cfg: EvaluationConfig, what: str) -> None:
+    """The increment velocity algorithm's structure, coefficients and N (``what``: the
+    motion, for the message)."""
+    from strapdown.algorithms.coning import MAX_SUBSAMPLES
+
+    fam = cfg.spec.family
+    if not cfg.spec.update_structure.runs_velocity:
+        raise InputError(f"the velocity algorithms run in the {' or '.join(nav_structures())} "
+                         f"structure, not {cfg.structure}")
+    if cfg.coefficients not in (None, fam.default_coefficients):
+        raise InputError(f"the velocity algorithms use the designer's sets (coning: "
+                         f"{fam.default_coefficients}); coefficients {cfg.coefficients} do not "
+                         f"apply to {what}")
+    if not 1 <= cfg.subsamples <= MAX_SUBSAMPLES:
+        raise InputError(f"N (subsamples) must be 1–{MAX_SUBSAMPLES} for the velocity "
+                         f"algorithms, got {cfg.subsamples}")
+
+
 def _validate_rate(cfg: EvaluationConfig) -> None:
     """The rate-input duals (:func:`strapdown.algorithms.velocity.integrate_inertial_rates`):
     their own structure only (conventional), coefficients derived or paper, float64."""
-    if cfg.structure != "conventional":
+    if cfg.spec.family.velocity(cfg.spec) is None:  # an interleaved structure (sliding)
         raise InputError(f"the rate-input velocity algorithms have one structure (an update "
                          f"every td or 3 td), not {cfg.structure}")
-    if cfg.coefficients not in (None, "derived", "paper"):
-        raise InputError(f"coefficients {cfg.coefficients} do not apply to {cfg.algorithm}; "
-                         "choose derived or paper")
     if cfg.precision is not None:
         raise InputError(f"{cfg.algorithm} on the sculling motion runs in float64 only; "
                          "drop --precision")
@@ -178,8 +197,7 @@ class ScullingEvaluation:
         return {
             "motion": c.motion, "algorithm": c.algorithm, "structure": c.structure,
             "subsamples": c.subsamples,
-            "coefficients": (c.coefficients or "derived") if c.algorithm != "rotvec"
-            else "table3",
+            "coefficients": c.coefficients or c.spec.family.default_coefficients,
             "precision_digits": c.precision,
             "angle_amplitude_deg": c.angle_amplitude_deg, "accel_amplitude_m_s2": c.accel_amplitude,
             "frequency_hz": c.frequency_hz, "phase_deg": c.phase_deg,
@@ -209,7 +227,7 @@ def _errors(cfg: EvaluationConfig, motion: ScullingMotion, h: float,
     if cfg.precision is not None:
         s = integrate_inertial_mp(motion, cfg.subsamples, h=h, samples=samples,
                                   digits=cfg.precision, structure=structure)
-        period = h if cfg.structure == "single-chain" else cfg.subsamples * h
+        period = cfg.spec.update_structure.update_period(cfg.subsamples, h)
         return s.t, s.dv, s.dp, s.startup, period
     edges = np.arange(samples + 1) * h
     sol = integrate_inertial(motion.increments(edges), motion.velocity_increments(edges),
@@ -252,18 +270,11 @@ def validate_coning_force(cfg: EvaluationConfig) -> None:
     arbitrary precision the limits of :func:`validate_sculling`."""
     from strapdown.algorithms.coning import MAX_SUBSAMPLES
 
-    if cfg.algorithm != "rotvec":
+    if cfg.algorithm not in _increment_velocity_algorithms():
         raise InputError(f"the coning-force motion runs the increment velocity algorithms "
-                         f"(rotvec, N = 1–{MAX_SUBSAMPLES}); {cfg.algorithm} has no law here")
-    if cfg.structure not in NAV_STRUCTURES:
-        raise InputError(f"the velocity algorithms run in the {' or '.join(NAV_STRUCTURES)} "
-                         f"structure, not {cfg.structure}")
-    if cfg.coefficients not in (None, "table3"):
-        raise InputError(f"the velocity algorithms use the designer's sets (coning: table3); "
-                         f"coefficients {cfg.coefficients} do not apply to this motion")
-    if not 1 <= cfg.subsamples <= MAX_SUBSAMPLES:
-        raise InputError(f"N (subsamples) must be 1–{MAX_SUBSAMPLES} for the velocity "
-                         f"algorithms, got {cfg.subsamples}")
+                         f"({', '.join(_increment_velocity_algorithms())}, N = 1–"
+                         f"{MAX_SUBSAMPLES}); {cfg.algorithm} has no law here")
+    _validate_increment_velocity(cfg, "this motion")
     if cfg.gyro is not None and not cfg.gyro.is_ideal:
         raise InputError("the coning-force motion takes ideal sensors only (no gyro errors)")
     a = _finite("half angle (deg)", cfg.half_angle_deg)

@@ -28,8 +28,9 @@ def _arguments(p: argparse.ArgumentParser) -> None:
                    help="the algorithm to generate (nav: the navigation update on the WGS-84 "
                    "Earth with coning and sculling compensation; ahrs: the AHRS filter of "
                    "strapdown ahrs, one update per IMU sample)")
-    p.add_argument("--structure", choices=STRUCTURES, default="conventional",
-                   help=structure_help(ATTITUDE_ALGORITHMS) + "; nav: conventional, single-chain")
+    p.add_argument("--structure", choices=STRUCTURES, default=None,
+                   help=structure_help(ATTITUDE_ALGORITHMS) + "; nav: conventional, single-chain "
+                   "(default: the first each algorithm lists, conventional)")
     p.add_argument("--subsamples", type=int, default=None,
                    help="N, subsamples per update (rotvec and nav only, default 3; an error for "
                    "the other algorithms)")
@@ -82,7 +83,10 @@ def run(args: argparse.Namespace) -> int:
         if args.sample_rate_hz is not None:
             raise ValueError("--sample-rate-hz does not apply to nav (its init takes the "
                              "sample interval h)")
-        e = export_c(args.out, algorithm=args.algorithm, structure=args.structure,
+        from strapdown.algorithms.velocity import nav_structures
+
+        e = export_c(args.out, algorithm=args.algorithm,
+                     structure=args.structure or nav_structures()[0],
                      subsamples=3 if args.subsamples is None else args.subsamples,
                      coefficients=args.coefficients, real=args.real, name=args.name,
                      **({} if args.velocity_set is None
@@ -107,7 +111,8 @@ def run(args: argparse.Namespace) -> int:
     elif args.sample_rate_hz is not None:
         raise ValueError(f"--sample-rate-hz does not apply to {args.algorithm} (its input is "
                          "increments; the generated code does not depend on the rate)")
-    e = export_c(args.out, algorithm=args.algorithm, structure=args.structure,
+    e = export_c(args.out, algorithm=args.algorithm,
+                 structure=args.structure or fam.structures[0],  # the family's default
                  subsamples=3 if args.subsamples is None else args.subsamples,
                  coefficients=args.coefficients, real=args.real, name=args.name,
                  **({} if h is None else {"h": h}))
@@ -147,7 +152,7 @@ def _run_ahrs(args: argparse.Namespace) -> int:
     if args.sample_rate_hz is None or not args.sample_rate_hz > 0:
         raise ValueError("ahrs bakes the IMU's sample rate into the code: pass a positive "
                          "--sample-rate-hz (Hz)")
-    for opt, given in (("--structure", args.structure != "conventional"),
+    for opt, given in (("--structure", args.structure is not None),
                        ("--subsamples", args.subsamples is not None),
                        ("--coefficients", args.coefficients is not None)):
         if given:

@@ -22,20 +22,28 @@ from __future__ import annotations
 
 import re
 from fractions import Fraction
+from pathlib import Path
 
 from strapdown.algorithms import _nav_kernels as nk
 from strapdown.algorithms import tables
 from strapdown.algorithms.coning import coefficient_set
-from strapdown.algorithms.structures import single_chain_coefficients
+from strapdown.algorithms.structures import (
+    STRUCTURE_REGISTRY,
+    UpdateStructure,
+    single_chain_coefficients,
+)
 from strapdown.algorithms.velocity import (
     DEFAULT_VELOCITY_SET,
-    NAV_STRUCTURES,
     VelocitySet,
     effective_velocity_set,
+    nav_structures,
     sculling_matrix,
 )
 
 __all__ = ["fill_names", "generate_nav", "nav_ops"]
+
+#: The C templates beside this module (the navigation step: ``nav_step.c.in``).
+_TEMPLATES = Path(__file__).parent / "templates"
 
 
 def _lit(x) -> str:
@@ -125,112 +133,9 @@ static void sd_left_update(const NAME_real z[3], const NAME_real q[4], NAME_real
 
 
 def _step() -> str:
-    """One navigation update from body increments (``earth_nav_chunk_kernel``'s loop body)."""
-    return """
-/* out[0..2] = w_in, out[3..5] = gamma - (w_ie + w_in) x v, out[6..8] = (dlat, dlon, dh)/dt */
-static void sd_rates(NAME_real lat, NAME_real hgt, const NAME_real v[3], NAME_real out[9])
-{
-    NAME_real sl = sin(lat), cl = cos(lat), s2, d, sq, e0, e1, g0, gam, wie0, wie2, w0, w1, w2;
-    s2 = sl * sl;
-    d = 1.0 - PREFIX_E2 * s2;
-    sq = sqrt(d);
-    e0 = PREFIX_A * (1.0 - PREFIX_E2) / (d * sq) + hgt;
-    e1 = PREFIX_A / sq + hgt;
-    g0 = PREFIX_GE * (1.0 + PREFIX_GK * s2) / sq;
-    gam = g0 * (1.0 - 2.0 / PREFIX_A * (1.0 + PREFIX_F + PREFIX_GM - 2.0 * PREFIX_F * s2) * hgt
-                + 3.0 * hgt * hgt / (PREFIX_A * PREFIX_A));
-    wie0 = PREFIX_OMEGA * cl;
-    wie2 = -PREFIX_OMEGA * sl;
-    out[0] = wie0 + v[1] / e1;
-    out[1] = -v[0] / e0;
-    out[2] = wie2 - v[1] * (sl / cl) / e1;
-    w0 = wie0 + out[0];
-    w1 = out[1];
-    w2 = wie2 + out[2];
-    out[3] = -(w1 * v[2] - w2 * v[1]);
-    out[4] = -(w2 * v[0] - w0 * v[2]);
-    out[5] = gam - (w0 * v[1] - w1 * v[0]);
-    out[6] = v[0] / e0;
-    out[7] = v[1] / (e1 * cl);
-    out[8] = -v[2];
-}
-
-/* Adams-Moulton mean over an update from its end (a) and the k - 1 updates before */
-static inline NAME_real sd_am(int k, NAME_real a, NAME_real b, NAME_real c, NAME_real d)
-{
-    if (k == 2) return 0.5 * (a + b);
-    if (k == 3) return (5.0 * a + 8.0 * b - c) / 12.0;
-    return (9.0 * a + 19.0 * b - 5.0 * c + d) / 24.0;
-}
-
-/* the value at the update's end extrapolated from the k - 1 before */
-static inline NAME_real sd_extrap(int k, NAME_real b, NAME_real c, NAME_real d)
-{
-    if (k == 2) return b;
-    if (k == 3) return 2.0 * b - c;
-    return 3.0 * b - 3.0 * c + d;
-}
-
-/* the navigation update from the body increments phi, dvb over one update period */
-static void sd_nav_step(NAME_state *s, const NAME_real phi[3], const NAME_real dvb[3])
-{
-    const NAME_real T = s->period;
-    NAME_real (*H)[12] = s->hist;
-    NAME_real zeta[3], x[3], an[3], t1[3], t2[3], t3[3], t4[3], t5[3], t6[3], db[3], dx[3];
-    NAME_real dz[3], pred[9], end[9], pp[3], vn[3], pn[3], qb[4], w;
-    int c, k;
-    if (s->nh == 0) {
-        sd_rates(s->pos[0], s->pos[2], s->v, H[0]);
-        s->nh = 1;
-    }
-    k = s->nh + 1;
-    for (c = 0; c < 9; ++c) pred[c] = sd_extrap(k, H[0][c], H[1][c], H[2][c]);
-    /* navigation-frame rotation over the update, zeta = integral of w_in, predicted */
-    for (c = 0; c < 3; ++c) zeta[c] = T * sd_am(k, pred[c], H[0][c], H[1][c], H[2][c]);
-    /* specific-force increment: body part rotated to n(m-1), then the frame rotation */
-    sd_rotate(s->q, dvb, x);
-    sd_rotate(s->q, phi, an);
-    sd_cross(zeta, x, t1);
-    sd_cross(an, x, t2);
-    sd_cross(zeta, t2, t3);
-    sd_cross(zeta, t1, t4);
-    /* the specific force's change in the body, C (dv_b,m - dv_b,m-1), and the frame
-       rotation's, dzeta = T (w_in,m - w_in,m-1) */
-    for (c = 0; c < 3; ++c) {
-        db[c] = s->nh > 1 ? dvb[c] - H[0][9 + c] : 0.0;
-        dz[c] = T * (pred[c] - H[0][c]);
-    }
-    sd_rotate(s->q, db, dx);
-    sd_cross(zeta, dx, t5);
-    sd_cross(dz, x, t6);
-    for (c = 0; c < 3; ++c)
-        vn[c] = (s->v[c] + (x[c] - 0.5 * t1[c] - t3[c] / 12.0 + t4[c] / 6.0
-                            - (t5[c] - t6[c]) / 12.0))
-                + T * sd_am(k, pred[3 + c], H[0][3 + c], H[1][3 + c], H[2][3 + c]);
-    /* predicted position, the rates at the update's end, then the correction */
-    for (c = 0; c < 3; ++c)
-        pp[c] = s->pos[c] + T * sd_am(k, pred[6 + c], H[0][6 + c], H[1][6 + c], H[2][6 + c]);
-    sd_rates(pp[0], pp[2], vn, end);
-    w = k == 2 ? 0.5 : (k == 3 ? 5.0 / 12.0 : 0.375);
-    for (c = 0; c < 3; ++c) vn[c] += T * w * (end[3 + c] - pred[3 + c]);
-    for (c = 0; c < 3; ++c)
-        pn[c] = s->pos[c] + T * sd_am(k, end[6 + c], H[0][6 + c], H[1][6 + c], H[2][6 + c]);
-    /* zeta again from the corrected end rates, with the frame's own coning
-       (T^2/12) w_in,m-1 x w_in,m, for the attitude */
-    sd_cross(H[0], end, dz);
-    for (c = 0; c < 3; ++c)
-        zeta[c] = T * (sd_am(k, end[c], H[0][c], H[1][c], H[2][c]) + T / 12.0 * dz[c]);
-    for (c = 0; c < 12; ++c) { H[2][c] = H[1][c]; H[1][c] = H[0][c]; }
-    for (c = 0; c < 9; ++c) H[0][c] = end[c];
-    for (c = 0; c < 3; ++c) H[0][9 + c] = dvb[c];
-    s->nh = s->nh < 3 ? s->nh + 1 : 3;
-    /* attitude: q_m = q(zeta)* (x) q_{m-1} (x) q(phi) */
-    sd_update(s->q, phi, qb);
-    for (c = 0; c < 3; ++c) zeta[c] = -zeta[c];
-    for (c = 0; c < 3; ++c) { s->pos[c] = pn[c]; s->v[c] = vn[c]; }
-    sd_left_update(zeta, qb, s->q);
-}
-"""
+    """One navigation update from body increments (``earth_nav_chunk_kernel``'s loop body):
+    ``templates/nav_step.c.in``."""
+    return "\n" + (_TEMPLATES / "nav_step.c.in").read_text(encoding="utf-8")
 
 
 def _cross_terms(matrix, exact, sym: str, a: str, b: str, out: str, twin: bool) -> list[str]:
@@ -370,10 +275,19 @@ def _times(d: dict[str, int], n: int) -> dict[str, int]:
     return {k: v * n for k, v in d.items()}
 
 
+def _nav_structure(structure: str) -> UpdateStructure:
+    """The registered structure, if the velocity algorithms (and so this code) run in it."""
+    found = STRUCTURE_REGISTRY.get(structure)
+    if found is None or not found.runs_velocity:
+        raise ValueError(f"nav supports the structures {', '.join(nav_structures())}, got "
+                         f"{structure!r}")
+    return found
+
+
 def nav_ops(structure: str, n: int, velocity_set: VelocitySet = DEFAULT_VELOCITY_SET
             ) -> dict[str, int]:
     """Operations per update of the generated navigation code."""
-    return (_conventional(n, velocity_set) if structure == "conventional"
+    return (_conventional(n, velocity_set) if _nav_structure(structure).whole_updates
             else _single_chain(n))[2]
 
 
@@ -441,11 +355,8 @@ def generate_nav(structure: str, n: int, name: str, update_helpers: str,
     structure's sculling pairs, as :func:`strapdown.algorithms.navigation.navigate` takes
     them (the library's default; the single chain has one set).
     """
-    if structure not in NAV_STRUCTURES:
-        raise ValueError(f"nav supports the structures {', '.join(NAV_STRUCTURES)}, got "
-                         f"{structure!r}")
-    velocity_set = effective_velocity_set(structure, velocity_set)  # validates the name
-    if structure == "conventional":
+    velocity_set = effective_velocity_set(_nav_structure(structure), velocity_set)
+    if _nav_structure(structure).whole_updates:  # conventional: an update every N samples
         fields, body, ops = _conventional(n, velocity_set)
         period, counter = f"{n}.0 * h", "count"
         what = f"an update every N = {n} samples"

@@ -37,6 +37,7 @@ from typing import Any
 import numpy as np
 
 from strapdown.algorithms.navigation import navigate
+from strapdown.algorithms.structures import structure as update_structure
 from strapdown.algorithms.velocity import (
     NAV_STRUCTURES,
     NavStructure,
@@ -233,7 +234,7 @@ def _realistic_table(r: Report) -> str:
     r.add(r.table("sculling_realistic", ["structure", "N", "law (m/s²)", "exact (m/s²)",
                                          "float64 (m/s²)", "exact/law", "float64/exact",
                                          "why"], rows))
-    nmax = max((n for st, n, _ in holds if st == "conventional"), default=0)
+    nmax = max((n for st, n, _ in holds if update_structure(st).whole_updates), default=0)
     grows = [g for _, _, g in cubic]
     text = (f"the law holds (1 %) up to N = {nmax} (conventional); beyond, the θ0³ terms "
             f"dominate (excess ×{min(grows):.2f}–{max(grows):.2f} when θ0 doubles)"
@@ -353,7 +354,7 @@ def _flight_rows(fl: EarthFlight, cases, curves: dict | None = None):
             t, dp, dv, da = _nav_errors(fl, rate, n, st, sculling=scul)
             errs.append((np.abs(dp[:, :2]).max(), np.abs(dp[:, 2]).max(), np.abs(dv).max(),
                          np.abs(da).max()))
-            if curves is not None and (st, n, scul) == ("conventional", 2, True):
+            if curves is not None and update_structure(st).whole_updates and n == 2 and scul:
                 curves[rate] = (t, np.linalg.norm(dp[:, :2], axis=1))
         label = f"{st}, N = {n}" + ("" if scul else ", no sculling terms")
         ratios[label] = np.array(errs[0]) / np.array(errs[1])
@@ -434,7 +435,7 @@ def _rest_rates() -> dict[tuple[str, int], tuple[float, float]]:
     out = {}
     for label, st, vs in CONING_VARIANTS:
         for n in NS:
-            if st == "single-chain" and n == 1:
+            if update_structure(st).own_startup and n == 1:  # N = 1: the conventional row
                 continue
             sol = integrate_inertial(g, a, n, h=CONE["h"], q0=m.attitude(0.0), structure=st,
                                      velocity_set=vs)
@@ -458,7 +459,7 @@ def _coned_flight_heights() -> dict[tuple[str, int], float]:
     out = {}
     for label, st, vs in CONING_VARIANTS:
         for n in NS:
-            if st == "single-chain" and n == 1:
+            if update_structure(st).own_startup and n == 1:  # N = 1: the conventional row
                 continue
             sol = navigate(g, a, n, h=CONE["h"], lat=s0.lat[0], lon=s0.lon[0],
                            height=s0.height[0], v0=s0.velocity[0], q0=s0.q[0], structure=st,
