@@ -248,10 +248,12 @@ int sd_nav_conventional_n3_update(sd_nav_conventional_n3_state *s, const real_t 
     sd_rotation_comp(alpha, ups, dvb);
     sd_cross_add(phi, 0.45 /* coning 9/20 */, s->th[0], s->th[2]);
     sd_cross_add(phi, 1.35 /* coning 27/20 */, s->th[1], s->th[2]);
+    sd_cross_add(dvb, 1.55 /* sculling 31/20 */, s->th[0], s->dv[1]);
+    sd_cross_add(dvb, 1.55 /* sculling 31/20 */, s->dv[0], s->th[1]);
     sd_cross_add(dvb, 0.45 /* sculling 9/20 */, s->th[0], s->dv[2]);
     sd_cross_add(dvb, 0.45 /* sculling 9/20 */, s->dv[0], s->th[2]);
-    sd_cross_add(dvb, 1.35 /* sculling 27/20 */, s->th[1], s->dv[2]);
-    sd_cross_add(dvb, 1.35 /* sculling 27/20 */, s->dv[1], s->th[2]);
+    sd_cross_add(dvb, -0.2 /* sculling -1/5 */, s->th[1], s->dv[2]);
+    sd_cross_add(dvb, -0.2 /* sculling -1/5 */, s->dv[1], s->th[2]);
     sd_nav_step(s, phi, dvb);
     for (i = 0; i < 3; ++i) { pos[i] = s->pos[i]; vel[i] = s->v[i]; }
     for (i = 0; i < 4; ++i) q[i] = s->q[i];

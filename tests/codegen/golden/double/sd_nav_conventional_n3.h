@@ -2,9 +2,10 @@
  * Navigation on the WGS-84 Earth (NED): coning, rotation and sculling compensated body
  * increments (an update every N = 3 samples), velocity with Earth rate, transport rate and Somigliana gravity,
  * position by Adams-Moulton quadrature of the Earth rates, attitude q_n_b. Savage (1998b);
- * sculling coefficients from the designer's sculling target (= the coning set, Ignagni 1998).
+ * sculling coefficients: velocity set coning-force, the designer's coning-force target on all pairs
+ * (classical sculling and a body coning in a constant specific force, both to order 2N).
  * Real type: double. Input: gyro increments (rad), accelerometer increments (m/s).
- * Operations per update: mul 348, add 284, div 50, sqrt 5, sin 2, cos 2, tan 0.
+ * Operations per update: mul 366, add 296, div 50, sqrt 5, sin 2, cos 2, tan 0.
  */
 #ifndef SD_NAV_CONVENTIONAL_N3_H
 #define SD_NAV_CONVENTIONAL_N3_H
