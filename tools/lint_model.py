@@ -73,10 +73,6 @@ ALLOWED: dict[str, tuple[frozenset[str], str]] = {
                          "designer, issue 26 velocity sets in progress"),
     "design/finite_amplitude.py": (frozenset({"name-dispatch", "long-function"}),
                                    "designer, issue 26 velocity sets in progress"),
-    # --- the C exporter (the AHRS C export is being added beside it this session)
-    "codegen/export_c.py": (frozenset({"name-dispatch", "long-function"}),
-                            "C exporter: structure dispatch and C templates in function "
-                            "bodies; the AHRS export is being added beside it"),
 }
 
 

@@ -187,8 +187,9 @@ def _generate_nav(structure: StructureName, subsamples: int,
     """The navigation update (:mod:`strapdown.codegen.nav_c`)."""
     from strapdown.codegen.nav_c import generate_nav
 
-    if coefficients not in (None, "table3"):
-        raise ValueError("nav exports the designed coning and sculling sets only (table3)")
+    designed = Rotvec.default_coefficients  # the coning set the velocity update runs
+    if coefficients not in (None, designed):
+        raise ValueError(f"nav exports the designed coning and sculling sets only ({designed})")
     if real != "double":
         raise ValueError("nav is exported in double only: a float latitude resolves 0.6 m")
     name = name or f"sd_nav_{structure.replace('-', '_')}_n{subsamples}"
@@ -225,11 +226,13 @@ def generate(algorithm: ExportName, *, structure: StructureName = "conventional"
     if real not in REALS:
         raise ValueError(f"--float must be double or float, got {real!r}")
     h = positive(h, "h (sample interval)")
+    fam = spec.family
     name = name or re.sub(r"[^a-z0-9]+", "_", f"sd_{algorithm}_{structure}"
-                          + (f"_n{subsamples}" if algorithm == "rotvec" else "")).strip("_")
+                          + (f"_n{subsamples}" if "subsamples" in fam.options else "")
+                          ).strip("_")
     if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", name):
         raise ValueError(f"name must be a C identifier, got {name!r}")
-    return _assemble(algorithm == "rotvec", algorithm == "rk4", spec.family.reference, name,
+    return _assemble(fam.input_kind == "increment", isinstance(fam, Rk4), fam.reference, name,
                      real, h, _GENERATORS[algorithm](spec, real, h))
 
 
@@ -301,18 +304,24 @@ unsigned long {name}_state_size(void) {{ return (unsigned long)sizeof({name}_sta
 
 
 def _gen_rotvec(spec, real, h):
-    if spec.structure == "single-chain":
-        if spec.coefficients not in (None, "table3", "finite-amplitude"):
+    st = spec.update_structure
+    cs = coefficient_set(spec.coefficients or spec.family.default_coefficients,
+                         spec.subsamples)
+    if st.own_startup:  # the single chain: its designed coefficients, with their triples
+        try:
+            designed = st.chain_subsamples(cs) == cs.n  # not the plain sum
+        except ValueError:
+            designed = False
+        if not designed:
             raise ValueError("the single chain exports its designed coefficients only "
                              "(table3 or finite-amplitude)")
-        return _gen_single_chain(spec.subsamples, real, spec.coefficients == "finite-amplitude")
-    cs = coefficient_set(spec.coefficients or "table3", spec.subsamples)
-    if cs.triples and spec.structure != "conventional":
+        return _gen_single_chain(spec.subsamples, real, st.triple(cs))
+    if cs.triples and st.pair_only:
         raise ValueError(f"{cs.name!r} has triple cross products, which run in the "
                          "conventional and single-chain structures only")
-    if spec.structure == "conventional":
-        return _gen_conventional(cs, real)
-    return _gen_realtime(cs, real)
+    if st.interleaved:
+        return _gen_realtime(cs, real)
+    return _gen_conventional(cs, real)
 
 
 def _gen_single_chain(n, real, triple=False):
@@ -461,8 +470,8 @@ def _gen_rate(spec, real, h):
     struct = (f"    NAME_real qh[{u}][4];\n    NAME_real q0[4];\n    NAME_real win[{ring}][3];\n"
               "    long k;")
     macro = f"#define PREFIX_W(i) (s->win[((i) % {ring} + {ring}) % {ring}])"
-    sliding = structure == "sliding"
-    if algorithm == "rate-single" or not sliding:
+    sliding = spec.update_structure.interleaved  # the sliding scheme, started single-period
+    if not sliding:
         body_update = f"""
     /* sample index j = s->k - 1 just stored; an update completes every {u} samples */
     if (s->k - 1 < {u} || (s->k - 1) % {u} != 0) return 0;
