@@ -3,6 +3,7 @@ and the library; the rate-to-increment quadrature; streaming; bad input."""
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
@@ -105,6 +106,43 @@ def test_rate_log_in_deg_s_and_g_navigates_like_the_increments(tmp_path, flight)
     # ramps have no kinks), single chain N = 3: 3.4e-7 m, 1.3e-7 m/s
     dp, dv = _position_error(rows)
     assert np.max(np.abs(dp)) < 5e-6 and np.max(np.abs(dv)) < 2e-6
+
+
+@pytest.mark.parametrize(("algorithm", "updates", "left"), [("rate-single", 2000, 0),
+                                                            ("rate-three", 666, 2)])
+def test_rate_log_with_a_rate_family_navigates_like_the_library(tmp_path, flight, capsys,
+                                                               algorithm, updates, left):
+    """--algorithm: the rate family's velocity counterpart on the samples themselves
+    (navigate_rates), its update period, the tail it cannot use counted; the library's
+    numbers to round-off (the initial attitude went through yaw/pitch/roll)."""
+    edges, _, _, s0 = flight
+    w, f = _FLIGHT.sensed(edges)
+    log = tmp_path / "rates.csv"
+    _write_csv(log, ["t", "gx[rad/s]", "gy[rad/s]", "gz[rad/s]", "ax[m/s^2]", "ay[m/s^2]",
+                     "az[m/s^2]"], edges, w, f)
+    out = tmp_path / "nav.csv"
+    assert main(["nav", "--imu", str(log), *_init_args(s0), "--algorithm", algorithm,
+                 "--out", str(out), "--no-progress"]) == 0
+    assert ("trailing sample(s)" in capsys.readouterr().err) is bool(left)
+    rows = _read_out(out)
+    assert rows.shape[0] == updates + 1 and rows[0, 0] == 0.0
+    meta = json.loads((tmp_path / "nav.csv.meta.json").read_text())
+    assert meta["algorithm"] == algorithm and meta["trailing_samples_dropped"] == left
+    from strapdown.algorithms.navigation import navigate_rates
+
+    sol = navigate_rates(w, f, td=H, lat=math.radians(52.0), lon=math.radians(-3.0),
+                         height=350.0, v0=s0.velocity[0], q0=s0.q[0], algorithm=algorithm)
+    assert np.allclose(rows[:, 0], sol.t, rtol=0, atol=1e-12)
+    assert np.allclose(rows[:, 4:7], sol.v, rtol=0, atol=1e-9)
+    dp, dv = _position_error(rows)
+    assert np.max(np.abs(dp)) < 1e-3 and np.max(np.abs(dv)) < 1e-3
+    if left:
+        _fails(capsys, tmp_path, ["nav", "--imu", str(log), *_init_args(s0), "--algorithm",
+                                  algorithm, "--trailing", "error", "--out",
+                                  str(tmp_path / "x.csv")], "after the last whole update")
+    _fails(capsys, tmp_path, ["nav", "--imu", str(log), "--increments", *_init_args(s0),
+                              "--algorithm", algorithm, "--out", str(tmp_path / "y.csv")],
+           "it navigates rate logs")
 
 
 def test_increments_from_rates_is_exact_for_cubics():
