@@ -2,7 +2,8 @@
 
 The C (``templates/ahrs.c.in``, ``templates/ahrs.h.in``) mirrors
 :func:`strapdown.ahrs._kernel.ekf_kernel` function by function — each static function
-names the kernel function it repeats, same operations in the same order — and runs the
+names the kernel function it repeats; the covariance updates use P's symmetry and zero
+blocks, so the arithmetic differs at round-off (see the template's head) — and runs the
 causal filter of :func:`strapdown.ahrs.ekf` one sample at a time: the initial window
 (``init_window_s``) is buffered, its means give the initial attitude, the reference
 field and gravity as the library computes them, then the buffered samples and every
@@ -124,6 +125,20 @@ def _sizes(cfg: AhrsConfig, params: K.Params, prop: dict, mag: bool, n_init: int
             "ND": (dmax + stride // 2) // stride + 1 if mag else 1}
 
 
+def _epoch_constants(cfg: AhrsConfig, params: K.Params, prop: dict, h: float,
+                     real: str) -> dict[str, str]:
+    """Macros the C would otherwise compute per update from constants: the Singer
+    process's exponentials over the epoch's (constant) T (``_process_noise``), and the
+    sample counts from which ``max(alpha, 1/n)`` is ``alpha`` (the rest detector's and
+    the delay estimator's averaging gains: 1/n < alpha/2 there, whatever the rounding)."""
+    T = 2.0 * h if prop["rk4"] else int(prop["stride"]) * h  # _rk4_step, _window_step
+    rest_alpha = h / cfg.rest_tau
+    return {"EXPT": _lit(math.exp(-T / params.singer_tau), real),
+            "EXP2T": _lit(math.exp(-2.0 * T / params.singer_tau), real),
+            "REST_N": f"{math.ceil(2.0 / rest_alpha) + 1}L",
+            "DELAY_N": f"{math.ceil(2.0 / params.mag_delay_alpha) + 1}L"}
+
+
 def _constants(cfg: AhrsConfig, params: K.Params, prop: dict, h: float, mag: bool,
                real: str) -> str:
     """The .c file's constants: macros, the Params struct, tables, flags."""
@@ -136,7 +151,7 @@ def _constants(cfg: AhrsConfig, params: K.Params, prop: dict, h: float, mag: boo
               "PI": _lit(math.pi, real), "TINY": _lit(1e-300 if real == "double" else 1e-30,
                                                        real),
               "COS_DECL": _lit(math.cos(d), real), "SIN_DECL": _lit(math.sin(d), real),
-              "NAN": "((NAME_real)NAN)"}
+              "NAN": "((NAME_real)NAN)", **_epoch_constants(cfg, params, prop, h, real)}
     lines = [f"#define PREFIX_{k} {v}" for k, v in macros.items()]
     lit = lambda v: _lit(v, real)  # noqa: E731
     lines += ["", "/* the propagation algorithm's window (filter._algorithm): node offsets, "
