@@ -82,7 +82,9 @@ Q_NED_ENU = np.array([0.0, math.sqrt(0.5), math.sqrt(0.5), 0.0])
 class AhrsConfig:
     """Filter tuning (SI units). Defaults work on consumer MEMS IMUs at 100–1000 Hz; the
     defaults marked "(CV)" were chosen by cross-validation on BROAD (Laidig et al.
-    (2021); docs/reproductions.md gives the held-out figures).
+    (2021); docs/reproductions.md gives the held-out figures); ``tilt_rate_noise`` and
+    ``acc_motion_leak`` by the cross-validation across kinds of data (BROAD's groups, the
+    simulated scenario kinds with and without magnetometer; ``benchmarks/ahrs_cv_kinds.py``).
 
     Parameters
     ----------
@@ -96,7 +98,8 @@ class AhrsConfig:
         Tilt process noise per unit rotation rate, rad/√Hz per rad/s: the gyro's
         scale-factor and misalignment errors make the tilt more uncertain the faster
         the sensor turns, ``Q_tilt = tilt_rate_noise² |ω|² T`` on the two horizontal
-        axes (CV; 0 switches it off).
+        axes (0 switches it off). Default 2.1e-3, chosen with ``acc_motion_leak`` by the
+        cross-validation across kinds of data (issue 25); BROAD's alone chose 4.2e-3.
     heading_rate_noise : float
         The same for the heading axis (CV): while the field is rejected, the heading's
         uncertainty grows with the rotation, so the field weighs more once it is used
@@ -129,7 +132,9 @@ class AhrsConfig:
         ``ā²``: the moving mean square, over τ, of the reference-frame specific force less
         its low-passed value), so a body whose accelerometer never sees gravity alone — a
         swing, a circle, a spin at a lever arm — is weighed by what the data show. 0
-        switches it off.
+        switches it off. Default 0.25, with ``tilt_rate_noise`` chosen by the
+        cross-validation across kinds of data (``benchmarks/ahrs_cv_kinds.py``;
+        docs/reproductions.md).
     acc_gate_lowpass : float
         NIS gate of the low-passed measurement (χ², 2 dof, 99.9 %: 13.82).
     acc_lowpass_norm_tol : float
@@ -294,7 +299,7 @@ class AhrsConfig:
     gyro_noise: float = 1.4e-3
     gyro_bias_rw: float = 2.5e-6
     gyro_bias_sigma0: float = 0.01
-    tilt_rate_noise: float = 4.2e-3
+    tilt_rate_noise: float = 2.1e-3
     heading_rate_noise: float = 0.0
     singer_sigma: float = 2.0
     singer_tau: float = 0.2
@@ -308,7 +313,7 @@ class AhrsConfig:
     acc_lowpass_s: float = 2.1
     acc_lowpass_noise: float = 0.0252
     acc_gate_lowpass: float = 13.82
-    acc_motion_leak: float = 0.0
+    acc_motion_leak: float = 0.25
     acc_lowpass_norm_tol: float = 0.015
     acc_gate_mode: str = "hard"
     lever_arm: float = 0.1
