@@ -34,6 +34,8 @@ Navigation
     stamped ``t_1`` starts at ``t₀ = t_1 − h``, the time of the initial state (position
     in rad and m above the ellipsoid, NED velocity, ``q_n_b``). The :class:`NavSolution`
     holds row 0 = that initial state, then one row per update stamped at its end.
+    :func:`navigate_rates` does the same from rate and specific-force samples with any
+    rate family that has a velocity counterpart (``Family.velocity``).
     ``strapdown nav`` writes the same rows with the z-y-x Euler angles (deg) beside the
     quaternion; from a rate log ``t₀`` is the first sample's stamp.
 Errors
@@ -104,6 +106,7 @@ _EXPORTS = {
     "RotvecStream": "strapdown.algorithms.streaming",
     # navigation on the WGS-84 Earth (NED)
     "navigate": "strapdown.algorithms.navigation",
+    "navigate_rates": "strapdown.algorithms.navigation",
     "NavStream": "strapdown.algorithms.navigation",
     "NavSolution": "strapdown.algorithms.navigation",
     # the AHRS
