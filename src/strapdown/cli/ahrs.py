@@ -80,7 +80,8 @@ def _arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--mag-sample", choices=["point", "interval"], default="point",
                    help="what a magnetometer sample is, beside interval gyro samples: the "
                    "field at its stamp (point: a magnetometer read at an instant; turned back "
-                   "half a period to where the attitude refers) or a mean like the gyro's")
+                   "half a period to where the attitude refers; the default) or a mean like "
+                   "the gyro's (interval)")
     p.add_argument("--no-mag", action="store_true", help="ignore the magnetometer")
     p.add_argument("--no-gating", action="store_true",
                    help="accept every measurement (no innovation gating or disturbance checks)")
