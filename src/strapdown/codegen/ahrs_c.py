@@ -127,13 +127,13 @@ def _sizes(cfg: AhrsConfig, params: K.Params, prop: dict, mag: bool, n_init: int
 
 def _epoch_constants(cfg: AhrsConfig, params: K.Params, prop: dict, h: float,
                      real: str) -> dict[str, str]:
-    """Macros the C would otherwise compute per update from constants: the Singer
+    """Macros the C would otherwise compute per update from constants: 1/T and the Singer
     process's exponentials over the epoch's (constant) T (``_process_noise``), and the
     sample counts from which ``max(alpha, 1/n)`` is ``alpha`` (the rest detector's and
     the delay estimator's averaging gains: 1/n < alpha/2 there, whatever the rounding)."""
     T = 2.0 * h if prop["rk4"] else int(prop["stride"]) * h  # _rk4_step, _window_step
     rest_alpha = h / cfg.rest_tau
-    return {"EXPT": _lit(math.exp(-T / params.singer_tau), real),
+    return {"INV_T": _lit(1.0 / T, real), "EXPT": _lit(math.exp(-T / params.singer_tau), real),
             "EXP2T": _lit(math.exp(-2.0 * T / params.singer_tau), real),
             "REST_N": f"{math.ceil(2.0 / rest_alpha) + 1}L",
             "DELAY_N": f"{math.ceil(2.0 / params.mag_delay_alpha) + 1}L"}
