@@ -60,13 +60,14 @@ Layout (imports point only down this list; ``make lint`` enforces it)
 ``analysis``
     errors, drift rates and analytic predictions, one configuration evaluated end to end,
     BROAD's metrics.
-``ahrs``
-    the error-state EKF.
+``ahrs``, ``navigation``
+    the error-state EKF; navigation (``navigate``, the inertial integrator of the sculling
+    studies) with its compiled kernels and their plain-Python twins.
 ``algorithms``
     the algorithm model (:class:`AlgorithmSpec` and its registry), coning sets, update
     structures, rate-input and quaternion algorithms, cone kinematics, streaming, the
-    velocity and navigation updates (``navigate``), the arbitrary-precision path, the
-    compiled kernels and their plain-Python twin.
+    velocity update, the arbitrary-precision path, the compiled kernels and their
+    plain-Python twins.
 ``truth``, ``io``
     reference motions, sensor and trajectory models; log readers and file output.
 ``rotation``
@@ -105,10 +106,10 @@ _EXPORTS = {
     "rate_attitude": "strapdown.algorithms.rate",
     "RotvecStream": "strapdown.algorithms.streaming",
     # navigation on the WGS-84 Earth (NED)
-    "navigate": "strapdown.algorithms.navigation",
-    "navigate_rates": "strapdown.algorithms.navigation",
-    "NavStream": "strapdown.algorithms.navigation",
-    "NavSolution": "strapdown.algorithms.navigation",
+    "navigate": "strapdown.navigation",
+    "navigate_rates": "strapdown.navigation",
+    "NavStream": "strapdown.navigation",
+    "NavSolution": "strapdown.navigation",
     # the AHRS
     "AhrsConfig": "strapdown.ahrs",
     "ekf": "strapdown.ahrs",
@@ -134,6 +135,7 @@ _MODULES = {
     "algorithms": "strapdown.algorithms",
     "analysis": "strapdown.analysis",
     "ahrs": "strapdown.ahrs",
+    "navigation": "strapdown.navigation",
     "design": "strapdown.design",
     "io": "strapdown.io",
     "truth": "strapdown.truth",

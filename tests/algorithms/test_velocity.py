@@ -9,29 +9,29 @@ import numpy as np
 import pytest
 
 from strapdown._core.backend import NUMPY
-from strapdown.algorithms import _nav_reference as ref
+from strapdown.algorithms import _velocity_reference as vref
 from strapdown.algorithms.coning import coefficient_set
 from strapdown.algorithms.structures import single_chain_table
 from strapdown.algorithms.velocity import (
-    integrate_inertial,
-    integrate_inertial_mp,
     sculling_law,
     sculling_matrix,
     sculling_single_chain_table,
 )
+from strapdown.navigation import _reference as ref
+from strapdown.navigation import integrate_inertial, integrate_inertial_mp
 from strapdown.truth.sculling import classical_sculling
 
 
 def _twin(g, a, n, h, structure, velocity_set="coning-force"):
     gl, al = [tuple(r) for r in g], [tuple(r) for r in a]
     if structure == "conventional":
-        body = ref.conventional_body(gl, al, coefficient_set("table3", n).matrix.tolist(),
-                                     sculling_matrix(n, velocity_set=velocity_set).tolist(), h,
-                                     0.0)
+        body = vref.conventional_body(gl, al, coefficient_set("table3", n).matrix.tolist(),
+                                      sculling_matrix(n, velocity_set=velocity_set).tolist(),
+                                      h, 0.0)
         period = n * h
     else:
-        body = ref.single_chain_body(gl, al, single_chain_table(n).tolist(),
-                                     sculling_single_chain_table(n).tolist(), h)
+        body = vref.single_chain_body(gl, al, single_chain_table(n).tolist(),
+                                      sculling_single_chain_table(n).tolist(), h)
         period = h
     q, v, p = ref.inertial(body, period, (1.0, 0.0, 0.0, 0.0), (0.0,) * 3, (0.0,) * 3, NUMPY)
     return np.array(q), np.array(v), np.array(p)

@@ -9,15 +9,13 @@ import math
 import numpy as np
 import pytest
 
-from strapdown.algorithms.navigation import navigate
 from strapdown.algorithms.velocity import (
     DEFAULT_VELOCITY_SET,
     body_increments,
     coning_force_law,
-    integrate_inertial,
-    integrate_inertial_mp,
     sculling_matrix,
 )
+from strapdown.navigation import integrate_inertial, integrate_inertial_mp, navigate
 from strapdown.truth.coning_force import ConedFlight, ConingInForce
 from strapdown.truth.trajectory import EarthFlight, EarthSegment
 

@@ -7,7 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from strapdown.algorithms.velocity import integrate_inertial_rates, rate_sculling_law
+from strapdown.algorithms.velocity import rate_sculling_law
+from strapdown.navigation import integrate_inertial_rates
 from strapdown.truth.sculling import classical_sculling
 
 THETA, PSI = 1e-3, 0.3

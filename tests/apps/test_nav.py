@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 from scipy.io import savemat
 
-from strapdown.algorithms.navigation import navigate
 from strapdown.apps import nav as nav_app
 from strapdown.apps.nav import NAV_COLUMNS, increments_from_rates
 from strapdown.cli import main
+from strapdown.navigation import navigate
 from strapdown.truth import earth
 from strapdown.truth.trajectory import EarthFlight, EarthSegment
 
@@ -128,7 +128,7 @@ def test_rate_log_with_a_rate_family_navigates_like_the_library(tmp_path, flight
     assert rows.shape[0] == updates + 1 and rows[0, 0] == 0.0
     meta = json.loads((tmp_path / "nav.csv.meta.json").read_text())
     assert meta["algorithm"] == algorithm and meta["trailing_samples_dropped"] == left
-    from strapdown.algorithms.navigation import navigate_rates
+    from strapdown.navigation import navigate_rates
 
     sol = navigate_rates(w, f, td=H, lat=math.radians(52.0), lon=math.radians(-3.0),
                          height=350.0, v0=s0.velocity[0], q0=s0.q[0], algorithm=algorithm)

@@ -11,9 +11,9 @@ import math
 import numpy as np
 import pytest
 
-from strapdown.algorithms.navigation import navigate
 from strapdown.apps.nav import NAV_COLUMNS
 from strapdown.cli import main
+from strapdown.navigation import navigate
 from strapdown.rotation.dcm import dcm_from_quat, quat_from_dcm
 from strapdown.rotation.euler import dcm_from_euler_zyx, euler_zyx_from_dcm
 from strapdown.truth.trajectory import EarthFlight, EarthSegment
@@ -172,7 +172,7 @@ def test_gravity_model_is_the_library_s_and_recorded(tmp_path, flight):
 
 def test_import_strapdown_exposes_the_navigation():
     import strapdown
-    from strapdown.algorithms import navigation
+    from strapdown import navigation
 
     assert strapdown.navigate is navigation.navigate
     assert strapdown.NavStream is navigation.NavStream

@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 
 from c_harness import build
-from strapdown.algorithms.navigation import navigate
 from strapdown.codegen.export_c import ALGORITHMS, export_c, generate
 from strapdown.codegen.nav_c import nav_ops
+from strapdown.navigation import navigate
 from strapdown.truth.trajectory import EarthFlight, EarthSegment
 
 H = 0.01

@@ -51,7 +51,7 @@ def _html(site: Path, page: str) -> str:
     ("api/strapdown.algorithms.spec", "strapdown.algorithms.spec.AlgorithmSpec"),
     ("api/strapdown.ahrs.filter", "strapdown.ahrs.filter.ekf"),
     ("api/strapdown.io.readers", "strapdown.io.readers.read_imu"),
-    ("api/strapdown.algorithms.navigation", "strapdown.algorithms.navigation.navigate"),
+    ("api/strapdown.navigation.earth", "strapdown.navigation.earth.navigate"),
     ("api/strapdown.truth.motions", "strapdown.truth.motions.ClassicalConing"),
     ("api/strapdown.design.designer", "strapdown.design.designer.derive"),
     ("api", "strapdown._core.errors.InputError"),

@@ -1,6 +1,7 @@
 """One line when numba is about to compile strapdown's kernels.
 
-The compiled loops (:mod:`strapdown.algorithms._kernels`, :mod:`strapdown.algorithms._nav_kernels`,
+The compiled loops (:mod:`strapdown.algorithms._kernels`,
+:mod:`strapdown.algorithms._velocity_kernels`, :mod:`strapdown.navigation._kernels`,
 :mod:`strapdown.ahrs._kernel`) are ``cache=True``: the first call of each kernel in a fresh
 environment compiles it (seconds; up to a minute for the AHRS), later calls load the machine
 code from numba's cache. Each command and each algorithm uses its own kernels, so a new one
@@ -41,7 +42,8 @@ API_MESSAGE = ("strapdown: compiling the numba kernels of {what} on their first 
                "of time)…")
 #: What :data:`API_MESSAGE` calls the kernels of each module.
 KERNELS = {"strapdown.algorithms._kernels": "the attitude algorithms",
-           "strapdown.algorithms._nav_kernels": "the navigation algorithms",
+           "strapdown.algorithms._velocity_kernels": "the velocity updates",
+           "strapdown.navigation._kernels": "the navigation algorithms",
            "strapdown.ahrs._kernel": "the AHRS filter"}
 #: The logger of :data:`API_MESSAGE`.
 LOGGER = "strapdown.compile"

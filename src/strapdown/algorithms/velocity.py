@@ -41,10 +41,13 @@ Classical-sculling law (derived by :func:`strapdown.design.derive` with
 vibrations is ``−c · θ0 A cos ψ (Ωh)^{2N}``, ``c = N!(N+1)!/(2N+2)!``, for both
 structures (:func:`sculling_law`).
 
-:func:`integrate_inertial` chains the increments in a non-rotating frame without gravity
-(the sculling studies); :mod:`strapdown.algorithms.navigation` on the WGS-84 Earth.
+The navigation layer chains these increments: in a non-rotating frame without gravity
+(:func:`strapdown.navigation.inertial.integrate_inertial`, the sculling studies) and on the
+WGS-84 Earth (:mod:`strapdown.navigation.earth`).
 
-Rate input (:func:`integrate_inertial_rates`): from rate and specific-force samples
+Rate input (:class:`WindowedRateVelocity`, chained by
+:func:`strapdown.navigation.inertial.integrate_inertial_rates`): from rate and
+specific-force samples
 ``ω_k``, ``f_k`` every ``td`` — the dual of Wang, Wang & Wang's single-period rate
 algorithm (``rate-single``, :mod:`strapdown.algorithms.rate`), an update every ``td``:
 ``θ = td/2 (ω_{k−1} + ω_k)``, ``υ = td/2 (f_{k−1} + f_k)``,
@@ -62,7 +65,6 @@ an update every 3 td; its sculling law is the coning law of ``rate-three``
 
 from __future__ import annotations
 
-import itertools
 from dataclasses import dataclass
 from fractions import Fraction
 from typing import TYPE_CHECKING, Literal, get_args
@@ -70,9 +72,9 @@ from typing import TYPE_CHECKING, Literal, get_args
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from strapdown._core.validation import as_quaternions, as_vectors, finite_array, positive
+from strapdown._core.validation import as_vectors, positive
 from strapdown._core.validation import positive_int as _positive_int
-from strapdown.algorithms import _nav_kernels, tables
+from strapdown.algorithms import _velocity_kernels, tables
 from strapdown.algorithms.coning import MAX_SUBSAMPLES, coefficient_set
 from strapdown.algorithms.structures import (
     STRUCTURE_REGISTRY,
@@ -97,16 +99,12 @@ __all__ = [
     "VELOCITY_SETS",
     "BodyIncrements",
     "ConingForceLaw",
-    "InertialSolution",
     "NavStructure",
     "ScullingLaw",
     "VelocitySet",
     "body_increments",
     "coning_force_law",
     "effective_velocity_set",
-    "integrate_inertial",
-    "integrate_inertial_mp",
-    "integrate_inertial_rates",
     "rate_sculling_law",
     "sculling_law",
     "sculling_matrix",
@@ -125,7 +123,7 @@ if NAV_STRUCTURES != get_args(NavStructure):  # one list of names: the Literal
 #: The velocity (sculling) sets of the conventional structure (module docstring).
 VelocitySet = Literal["coning-force", "classical"]
 VELOCITY_SETS: tuple[VelocitySet, ...] = get_args(VelocitySet)
-#: What ``body_increments``, ``integrate_inertial`` and the navigation run by default.
+#: What ``body_increments`` and the navigation (inertial and Earth) run by default.
 DEFAULT_VELOCITY_SET: VelocitySet = "coning-force"
 
 
@@ -319,14 +317,14 @@ def body_increments(gyro: ArrayLike, accel: ArrayLike, n: int, *, h: float,
         kc = np.ascontiguousarray(coefficient_set("table3", n).matrix)
         ks = sculling_matrix(n, velocity_set=velocity_set) if sculling else np.zeros((n, n))
         out = np.empty((3, m, 3))
-        _nav_kernels.conventional_body_kernel(g[: m * n], a[: m * n], kc, ks, h, out[0],
+        _velocity_kernels.conventional_body_kernel(g[: m * n], a[: m * n], kc, ks, h, out[0],
                                               out[1], out[2])
         return BodyIncrements(out[0], out[1], out[2], h, n * h, structure, n)
     if g.shape[0] < 1:
         raise ValueError("the single chain needs at least one sample")
     tab_s = sculling_single_chain_table(n)
     out = np.empty((3, g.shape[0], 3))
-    _nav_kernels.single_chain_body_kernel(g, a, single_chain_table(n),
+    _velocity_kernels.single_chain_body_kernel(g, a, single_chain_table(n),
                                           tab_s if sculling else np.zeros_like(tab_s), h,
                                           out[0], out[1], out[2])
     return BodyIncrements(out[0], out[1], out[2], h, h, structure, n)
@@ -472,137 +470,6 @@ def nav_structures() -> tuple[NavStructure, ...]:
                  if s.runs_velocity)
 
 
-@dataclass(frozen=True)
-class InertialSolution:
-    """Attitude, velocity and position in a non-rotating frame without gravity.
-
-    ``t`` (m,), ``q`` (m, 4) ``q_n_b``, ``v`` (m, 3) m/s, ``p`` (m, 3) m; ``startup`` the
-    first steady-state output (N − 1 for the single chain, else 0).
-    """
-
-    t: NDArray[np.float64]
-    q: NDArray[np.float64]
-    v: NDArray[np.float64]
-    p: NDArray[np.float64]
-    structure: NavStructure
-    n: int
-    h: float
-    update_period: float
-    startup: int = 0
-
-
-def _state(q0, v0, p0):
-    q = np.array([1.0, 0.0, 0.0, 0.0]) if q0 is None else as_quaternions(q0, "q0")
-    if q.shape != (4,):
-        raise ValueError(f"q0 must have shape (4,), got {q.shape}")
-    v = np.zeros(3) if v0 is None else as_vectors(v0, "v0")
-    p = np.zeros(3) if p0 is None else as_vectors(p0, "p0")
-    if v.shape != (3,) or p.shape != (3,):
-        raise ValueError(f"v0 and p0 must have shape (3,), got {v.shape} and {p.shape}")
-    return q / np.linalg.norm(q), v, p
-
-
-def integrate_inertial(gyro: ArrayLike, accel: ArrayLike, n: int, *, h: float,
-                       structure: NavStructure = "conventional", t0: float = 0.0,
-                       q0: ArrayLike | None = None, v0: ArrayLike | None = None,
-                       p0: ArrayLike | None = None, sculling: bool = True,
-                       velocity_set: VelocitySet = DEFAULT_VELOCITY_SET) -> InertialSolution:
-    """Strapdown integration in a non-rotating frame without gravity (sculling studies).
-
-    ``v_m = v_{m−1} + C_{m−1} Δv_b``, ``p_m = p_{m−1} + v_{m−1} T + C_{m−1} ΔR_b``,
-    ``q_m = q_{m−1} ⊗ q(φ_m)`` with the increments of :func:`body_increments`.
-    """
-    q0, v0, p0 = _state(q0, v0, p0)
-    t0 = float(finite_array(t0, "t0"))
-    b = body_increments(gyro, accel, n, h=h, structure=structure, sculling=sculling,
-                        velocity_set=velocity_set)
-    m = b.phi.shape[0]
-    q = np.empty((m + 1, 4))
-    v = np.empty((m + 1, 3))
-    p = np.empty((m + 1, 3))
-    _nav_kernels.inertial_kernel(b.phi, b.dv, b.dr, b.update_period, q0, v0, p0, q, v, p)
-    t = t0 + np.arange(m + 1) * b.update_period
-    startup = min(b.n - 1, m) if _structure(b.structure).own_startup else 0
-    return InertialSolution(t, q, v, p, structure, b.n, b.h, b.update_period, startup)
-
-
-@dataclass(frozen=True)
-class MpInertialSolution:
-    """Errors of an arbitrary-precision run, formed in high precision, as float64.
-
-    ``t`` (m,) output times; ``dv``, ``dp`` (m, 3) velocity and position errors
-    (computed − true) in the navigation frame.
-    """
-
-    t: NDArray[np.float64]
-    dv: NDArray[np.float64]
-    dp: NDArray[np.float64]
-    digits: int
-    startup: int = 0
-
-
-def integrate_inertial_mp(motion, n: int, *, h: float, samples: int, digits: int,
-                          structure: NavStructure = "conventional",
-                          velocity_set: VelocitySet = DEFAULT_VELOCITY_SET
-                          ) -> MpInertialSolution:
-    """:func:`integrate_inertial` in arbitrary precision on a closed-form sculling motion.
-
-    Exact increments (:meth:`~strapdown.truth.sculling.ScullingMotion.increment_mp`,
-    :meth:`~strapdown.truth.sculling.ScullingMotion.velocity_increment_mp`), exact
-    rational coefficients and the plain-Python twin of the kernels
-    (:mod:`strapdown.algorithms._nav_reference`) at ``digits`` significant digits; the
-    errors against the exact velocity and position are converted to float64 at the end.
-    """
-    import mpmath
-
-    from strapdown._core.backend import MPMATH
-    from strapdown.algorithms import _nav_reference as ref
-    from strapdown.algorithms.precision import MAX_MP_SAMPLES
-
-    n, h = _n(n), positive(h, "h (sample interval)")
-    samples, digits = _positive_int(samples, "samples"), _positive_int(digits, "digits")
-    if samples > MAX_MP_SAMPLES:
-        raise ValueError(f"{samples} samples exceed the arbitrary-precision limit of "
-                         f"{MAX_MP_SAMPLES}")
-    if digits < 17:
-        raise ValueError(f"digits must be at least 17 (float64 is ~16), got {digits}")
-    st = _structure(structure)
-    _velocity_set(velocity_set)
-    with mpmath.workdps(digits):
-        hm = mpmath.mpf(h)
-        edges = [k * hm for k in range(samples + 1)]
-        g = [motion.increment_mp(a, b) for a, b in itertools.pairwise(edges)]
-        a = [motion.velocity_increment_mp(a, b) for a, b in itertools.pairwise(edges)]
-        zero = mpmath.mpf(0)
-
-        def mp(rows):
-            return [[mpmath.mpf(v.numerator) / v.denominator for v in r] for r in rows]
-
-        if st.whole_updates:  # the conventional structure
-            kc = mp(coefficient_set("table3", n).exact)
-            body = ref.conventional_body(g, a, kc, mp(sculling_matrix(
-                n, exact=True, velocity_set=velocity_set)), hm, zero)
-            period, startup = n * hm, 0
-        else:
-            from strapdown.algorithms.structures import single_chain_coefficients
-
-            tab_c = [[Fraction(0)] * max(n - 1, 1) for _ in range(n)]
-            for m_ in range(1, n):
-                tab_c[m_][:m_] = single_chain_coefficients(m_ + 1)
-            body = ref.single_chain_body(g, a, mp(tab_c), mp(sculling_single_chain_table(
-                n, exact=True)), hm)
-            period, startup = hm, n - 1
-        _qs, vs, ps = ref.inertial(body, period, motion.attitude_mp(zero), (zero,) * 3,
-                                  (zero,) * 3, MPMATH)
-        t = [k * period for k in range(len(vs))]
-        dv = np.array([[float(c - e) for c, e in zip(v, motion.velocity_mp(tt), strict=True)]
-                       for v, tt in zip(vs, t, strict=True)])
-        dp = np.array([[float(c - e) for c, e in zip(p, motion.position_mp(tt), strict=True)]
-                       for p, tt in zip(ps, t, strict=True)])
-    return MpInertialSolution(np.array([float(x) for x in t]), dv, dp, digits,
-                              min(startup, len(t) - 1))
-
-
 def rate_velocity_algorithms() -> tuple[str, ...]:
     """The registered rate-input families with a velocity counterpart (in registry order):
     the duals of the rate-input coning algorithms (module docstring), asked of each family
@@ -651,45 +518,3 @@ def rate_sculling_law(coefficients: str = "derived", algorithm: str = "rate-sing
     if law is None:
         raise ValueError(f"{algorithm} has no known sculling law (its coning law is unknown)")
     return ScullingLaw(law.order, law.constant)
-
-
-def integrate_inertial_rates(omega: ArrayLike, force: ArrayLike, *, td: float,
-                             coefficients: str = "derived", algorithm: str = "rate-single",
-                             t0: float = 0.0, q0: ArrayLike | None = None,
-                             v0: ArrayLike | None = None,
-                             p0: ArrayLike | None = None) -> InertialSolution:
-    """Rate-input strapdown integration in a non-rotating frame without gravity.
-
-    Parameters
-    ----------
-    omega, force : array_like of shape (k, 3)
-        Angular rate (rad/s) and specific force (m/s²) samples every ``td``.
-    td : float
-        Sample interval (s).
-    coefficients : {"derived", "paper"}
-        The rate algorithm's coning coefficients, used for the sculling terms too.
-    algorithm : {"rate-single", "rate-three"}
-        ``rate-single``: an update every td (k ≥ 2); ``rate-three``: Simpson's 3/8 rule and
-        the three-period pair coefficients on ω, f at 0, td, 2td, 3td, an update every 3 td
-        (k ≥ 4; a tail of fewer than three intervals is dropped). Module docstring.
-
-    Notes
-    -----
-    The solution's ``structure`` is ``"single-chain"`` for rate-single (an update every
-    sample interval, ``n`` 1) and ``"conventional"`` for rate-three (``n`` 3).
-    """
-    w, f = _inputs(omega, force)
-    spec = _rate_spec(coefficients, algorithm)
-    vel = spec.family.velocity(spec)
-    assert vel is not None  # _rate_spec: a velocity counterpart
-    if w.shape[0] < vel.min_samples:
-        raise ValueError(f"{algorithm} needs at least {vel.min_samples} samples, got "
-                         f"{w.shape[0]}")
-    td = positive(td, "td (sample interval)")
-    q0, v0, p0 = _state(q0, v0, p0)
-    b = vel.body(w, f, td)
-    m = b.phi.shape[0]
-    q, v, p = np.empty((m + 1, 4)), np.empty((m + 1, 3)), np.empty((m + 1, 3))
-    _nav_kernels.inertial_kernel(b.phi, b.dv, b.dr, b.update_period, q0, v0, p0, q, v, p)
-    t = float(finite_array(t0, "t0")) + vel.start * td + np.arange(m + 1) * b.update_period
-    return InertialSolution(t, q, v, p, b.structure, b.n, td, b.update_period, 0)

@@ -44,15 +44,13 @@ from strapdown.algorithms.velocity import (
     NavStructure,
     coning_force_law,
     effective_velocity_set,
-    integrate_inertial,
-    integrate_inertial_mp,
-    integrate_inertial_rates,
     nav_structures,
     rate_sculling_law,
     rate_velocity_algorithms,
     sculling_law,
 )
 from strapdown.analysis.accuracy import drift_rate
+from strapdown.navigation import integrate_inertial, integrate_inertial_mp, integrate_inertial_rates
 from strapdown.truth.sculling import ScullingMotion, classical_sculling
 
 if TYPE_CHECKING:
@@ -144,7 +142,7 @@ def _validate_increment_velocity(cfg: EvaluationConfig, what: str) -> None:
 
 
 def _validate_rate(cfg: EvaluationConfig) -> None:
-    """The rate-input duals (:func:`strapdown.algorithms.velocity.integrate_inertial_rates`):
+    """The rate-input duals (:func:`strapdown.navigation.inertial.integrate_inertial_rates`):
     their own structure only (conventional), coefficients derived or paper, float64."""
     if cfg.spec.family.velocity(cfg.spec) is None:  # an interleaved structure (sliding)
         raise InputError(f"the rate-input velocity algorithms have one structure (an update "

@@ -202,7 +202,8 @@ def _sculling(nav_samples: int, peer_samples: int, repeat: int) -> list[_Job]:
     and single chain, N = 2) and smsfusion's StrapdownINS (rate and specific-force samples)."""
     import functools
 
-    from strapdown.algorithms.velocity import NavStructure, integrate_inertial
+    from strapdown.algorithms.velocity import NavStructure
+    from strapdown.navigation import integrate_inertial
     from strapdown.truth.sculling import classical_sculling
 
     theta0, om, acc, rate = SCULLING_BENCH

@@ -34,7 +34,7 @@ were dropped silently before. The single chain updates every sample and never le
 
 Gravity: WGS-84 normal gravity (Somigliana) with the second-order height correction
 (``gravity="wgs84"``, ``--gravity wgs84``, the default) or its linear term only
-(``"linear"``), as :func:`strapdown.algorithms.navigation.navigate`.
+(``"linear"``), as :func:`strapdown.navigation.earth.navigate`.
 
 A duplicated first row: an increment log whose first two rows hold identical values (at
 different stamps: a common simulator export repeats the first row, and the extra
@@ -46,12 +46,12 @@ the motion does, so only rows 0 and 1 equal with row 2 different warn.
 Output: ``t,lat_deg,lon_deg,height_m,vn,ve,vd,qw,qx,qy,qz,yaw_deg,pitch_deg,roll_deg``
 (NED, ``q_n_b`` Hamilton, scalar first, and its z-y-x Euler angles of the body in NED,
 pitch within ±90°, roll 0 at gimbal lock), CSV or ``.npz``. Row 0 is the initial state
-(as :func:`~strapdown.algorithms.navigation.navigate`'s :class:`NavSolution` has), at
+(as :func:`~strapdown.navigation.earth.navigate`'s :class:`NavSolution` has), at
 ``t0``: for increments the start of the first interval, the first stamp − h (each
 increment's stamp is the end of its interval); for rates the first sample's stamp. Then
 one row per update, ``t`` the end of the update. The navigation runs in chunks through
-:class:`strapdown.algorithms.navigation.NavStream` (bit for bit the one-shot
-:func:`~strapdown.algorithms.navigation.navigate`), each written as it completes to a
+:class:`strapdown.navigation.earth.NavStream` (bit for bit the one-shot
+:func:`~strapdown.navigation.earth.navigate`), each written as it completes to a
 temporary file renamed over the target at the end, so nothing is written on failure.
 """
 
@@ -72,12 +72,6 @@ from tqdm import tqdm
 
 from strapdown._core.errors import InputError
 from strapdown._core.kinds import InputKind
-from strapdown.algorithms.navigation import (
-    TRAILING_POLICIES,
-    NavSolution,
-    NavStream,
-    TrailingPolicy,
-)
 from strapdown.algorithms.rate import JITTER_TOLERANCE as STAMP_TOLERANCE
 from strapdown.algorithms.velocity import NavStructure
 from strapdown.io import read_imu
@@ -103,6 +97,12 @@ from strapdown.io.timing import (
     HeldPolicy,
     Timing,
     TimingMode,
+)
+from strapdown.navigation import (
+    TRAILING_POLICIES,
+    NavSolution,
+    NavStream,
+    TrailingPolicy,
 )
 from strapdown.rotation.dcm import dcm_from_quat, quat_from_dcm
 from strapdown.rotation.euler import dcm_from_euler_zyx, euler_zyx_from_dcm
@@ -491,7 +491,7 @@ def navigate_log(imu: str | os.PathLike[str], out: str | os.PathLike[str], *, la
     velocity : (VN, VE, VD) m/s, optional (default at rest)
     attitude_deg : (yaw, pitch, roll) °, z-y-x in NED, optional (default level, north)
     subsamples, structure, sculling
-        As :func:`strapdown.algorithms.navigation.navigate`.
+        As :func:`strapdown.navigation.earth.navigate`.
     accept_unit_warning : bool
         Magnitudes that suggest other units than declared warn instead of failing.
     progress : bool
@@ -507,7 +507,7 @@ def navigate_log(imu: str | os.PathLike[str], out: str | os.PathLike[str], *, la
         Rate logs only: a registered rate-input family with a velocity counterpart
         (:func:`strapdown.algorithms.velocity.rate_velocity_algorithms`), whose window turns
         the rate and specific-force samples into the update's increments
-        (:func:`strapdown.algorithms.navigation.navigate_rates`); ``subsamples`` and
+        (:func:`strapdown.navigation.earth.navigate_rates`); ``subsamples`` and
         ``structure`` are then not used. None (default): the rates are integrated to
         increments for the N-subsample update.
 
@@ -582,12 +582,12 @@ def navigate_log(imu: str | os.PathLike[str], out: str | os.PathLike[str], *, la
 
 class _RateRun:
     """A rate log navigated whole by a rate-input family's velocity counterpart
-    (:func:`~strapdown.algorithms.navigation.navigate_rates`), fed as :class:`NavStream` is:
+    (:func:`~strapdown.navigation.earth.navigate_rates`), fed as :class:`NavStream` is:
     its updates come with the first chunk."""
 
     def __init__(self, log: NavLog, algorithm: str, **kw: Any):
-        from strapdown.algorithms.navigation import navigate_rates
         from strapdown.algorithms.velocity import _rate_spec
+        from strapdown.navigation import navigate_rates
 
         try:
             spec = _rate_spec(None, algorithm)

@@ -93,7 +93,7 @@ def _attitude() -> None:
 
 def _navigation() -> None:
     """Both navigation structures, with and without sculling, at rest."""
-    from strapdown.algorithms.navigation import navigate
+    from strapdown.navigation import navigate
 
     n, h = 12, 0.01
     gyro = np.zeros((n, 3))

@@ -7,14 +7,14 @@ initial latitude, longitude, height, NED velocity and ``q_n_b``), ``<name>_reset
 ``<name>_update`` (one gyro increment in rad and one accelerometer increment in m/s in;
 position, velocity and attitude out, return value 1, whenever an update completes). No
 dynamic allocation; from libm ``sqrt``, ``sin`` and ``cos``. The code mirrors
-:func:`strapdown.algorithms._nav_kernels.conventional_body_kernel` /
-:func:`~strapdown.algorithms._nav_kernels.single_chain_body_kernel` and
-:func:`~strapdown.algorithms._nav_kernels.earth_nav_chunk_kernel` operation by operation
+:func:`strapdown.algorithms._velocity_kernels.conventional_body_kernel` /
+:func:`~strapdown.algorithms._velocity_kernels.single_chain_body_kernel` and
+:func:`strapdown.navigation._kernels.earth_nav_chunk_kernel` operation by operation
 (Savage (1998b); the sculling coefficients of the designer's sculling target, which are
 the coning ones, Ignagni (1998)); the position increment ``ΔR_b`` of the scrolling
 compensation is not part of it, as the Earth navigation integrates position by the
 Adams–Moulton rules of the position rates at the updates (see
-:mod:`strapdown.algorithms.navigation`). Double precision only: a float latitude resolves
+:mod:`strapdown.navigation.earth`). Double precision only: a float latitude resolves
 0.6 m.
 """
 
@@ -24,7 +24,6 @@ import re
 from fractions import Fraction
 from pathlib import Path
 
-from strapdown.algorithms import _nav_kernels as nk
 from strapdown.algorithms import tables
 from strapdown.algorithms.coning import coefficient_set
 from strapdown.algorithms.structures import (
@@ -39,6 +38,7 @@ from strapdown.algorithms.velocity import (
     nav_structures,
     sculling_matrix,
 )
+from strapdown.navigation import _kernels as nk
 
 __all__ = ["fill_names", "generate_nav", "nav_ops"]
 
@@ -68,7 +68,7 @@ def fill_names(text: str, name: str) -> str:
 
 
 def _helpers() -> str:
-    """The small functions of :mod:`strapdown.algorithms._nav_kernels`, in C."""
+    """The small functions of the velocity and navigation kernels, in C."""
     consts = "\n".join(f"#define {k} {_lit(v)}" for k, v in _CONSTANTS.items())
     return f"""
 /* WGS-84 (NIMA TR8350.2 (2000)): semi-major axis, flattening, e^2, Earth rate, Somigliana */
@@ -352,7 +352,7 @@ def generate_nav(structure: str, n: int, name: str, update_helpers: str,
 
     ``update_helpers``: the C of ``sd_update`` and ``sd_cross_add`` (shared with the attitude
     export, :mod:`strapdown.codegen.export_c`). ``velocity_set``: the conventional
-    structure's sculling pairs, as :func:`strapdown.algorithms.navigation.navigate` takes
+    structure's sculling pairs, as :func:`strapdown.navigation.navigate` takes
     them (the library's default; the single chain has one set).
     """
     velocity_set = effective_velocity_set(_nav_structure(structure), velocity_set)

@@ -36,18 +36,16 @@ from typing import Any
 
 import numpy as np
 
-from strapdown.algorithms.navigation import navigate
 from strapdown.algorithms.structures import structure as update_structure
 from strapdown.algorithms.velocity import (
     NAV_STRUCTURES,
     NavStructure,
     VelocitySet,
     coning_force_law,
-    integrate_inertial,
-    integrate_inertial_mp,
     sculling_law,
 )
 from strapdown.io.report import Report
+from strapdown.navigation import integrate_inertial, integrate_inertial_mp, navigate
 from strapdown.truth import earth
 from strapdown.truth.sculling import ScullingMotion, classical_sculling
 from strapdown.truth.trajectory import EarthFlight, EarthSegment

@@ -6,7 +6,7 @@ closed formula with the second-order free-air height correction
 default) or its linear term only (``model="linear"``: without ``3 h²/a²``, lighter by
 7.2e-7 m/s² at 1 km and 7.2e-5 m/s² at 10 km); the navigation frame is local
 north–east–down (Savage (1998b)). The compiled navigation kernel
-(:mod:`strapdown.algorithms._nav_kernels`) repeats these formulas; the tests hold them
+(:mod:`strapdown.navigation._kernels`) repeats these formulas; the tests hold them
 equal.
 """
 

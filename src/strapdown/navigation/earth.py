@@ -29,7 +29,7 @@ and the state at ``t_{m−1}``:
 The Earth terms are thus integrated to fourth order, from the first update on; the
 navigation's order is that of the body increments (on a smooth manoeuvre: second for
 N = 1, third for N ≥ 2, see ``strapdown reproduce sculling``), also on a manoeuvre that
-accelerates from its first update (``tests/algorithms/test_navigation_startup.py``: the
+accelerates from its first update (``tests/navigation/test_navigation_startup.py``: the
 first update's ζ used to come from the start rates alone, a one-off ``½ T² |ω̇_in|`` tilt,
 and the velocity update counted the body's rotation twice).
 
@@ -55,7 +55,6 @@ from numpy.typing import ArrayLike, NDArray
 
 from strapdown._core.errors import InputError
 from strapdown._core.validation import as_quaternions, as_vectors, finite_array
-from strapdown.algorithms import _nav_kernels
 from strapdown.algorithms.velocity import (
     DEFAULT_VELOCITY_SET,
     BodyIncrements,
@@ -63,6 +62,7 @@ from strapdown.algorithms.velocity import (
     VelocitySet,
     body_increments,
 )
+from strapdown.navigation import _kernels
 from strapdown.truth.earth import GRAVITY_MODELS, GravityModel, gravity_quadratic
 
 __all__ = ["GRAVITY_MODELS", "POLE_LIMIT_DEG", "TRAILING_POLICIES", "GravityModel",
@@ -181,7 +181,7 @@ def navigate(gyro: ArrayLike, accel: ArrayLike, n: int, *, h: float, lat: float,
     pos = np.empty((m + 1, 3))
     v = np.empty((m + 1, 3))
     q = np.empty((m + 1, 4))
-    _nav_kernels.earth_nav_kernel(b.phi, b.dv, b.update_period, lat, lon, height, v0, q0,
+    _kernels.earth_nav_kernel(b.phi, b.dv, b.update_period, lat, lon, height, v0, q0,
                                   pos, v, q, quad)
     t = float(finite_array(t0, "t0")) + np.arange(m + 1) * b.update_period
     _check_pole(t, pos[:, 0])
@@ -236,7 +236,7 @@ def _earth(b: BodyIncrements, lat: float, lon: float, height: float, v0, q0, t0:
     """The Earth navigation of body increments from validated initial state at ``t0``."""
     m = b.phi.shape[0]
     pos, v, q = np.empty((m + 1, 3)), np.empty((m + 1, 3)), np.empty((m + 1, 4))
-    _nav_kernels.earth_nav_kernel(b.phi, b.dv, b.update_period, lat, lon, height, v0, q0,
+    _kernels.earth_nav_kernel(b.phi, b.dv, b.update_period, lat, lon, height, v0, q0,
                                   pos, v, q, gravity_quadratic(gravity))
     t = t0 + np.arange(m + 1) * b.update_period
     _check_pole(t, pos[:, 0])
@@ -358,7 +358,7 @@ class NavStream:
         pos[0], v[0], q[0] = self._pos, self._v, self._q
         if m:
             assert body is not None
-            self._nh = _nav_kernels.earth_nav_chunk_kernel(
+            self._nh = _kernels.earth_nav_chunk_kernel(
                 np.ascontiguousarray(body[0]), np.ascontiguousarray(body[1]),
                 self.update_period, self._hist, self._nh, pos, v, q, self._quad)
             self._pos, self._v, self._q = pos[-1].copy(), v[-1].copy(), q[-1].copy()

@@ -18,7 +18,7 @@ import functools
 import numpy as np
 import pytest
 
-from strapdown.algorithms.navigation import navigate
+from strapdown.navigation import navigate
 from strapdown.rotation.error import attitude_error_angle
 from strapdown.truth import earth
 from strapdown.truth.trajectory import EarthFlight, EarthSegment

@@ -12,8 +12,7 @@ import pytest
 
 import strapdown
 from strapdown._core.errors import InputError
-from strapdown.algorithms import _nav_kernels
-from strapdown.algorithms.navigation import NavStream, TrailingSamplesWarning, navigate
+from strapdown.navigation import NavStream, TrailingSamplesWarning, _kernels, navigate
 from strapdown.truth import earth
 from strapdown.truth.trajectory import EarthFlight, EarthSegment
 
@@ -23,7 +22,7 @@ def test_kernel_gravity_is_the_earth_models(quad, model):
     out = np.empty(9)
     v = np.zeros(3)
     for hgt in (0.0, 1234.0, 1.0e4):
-        _nav_kernels._rates(0.7, hgt, v, out, quad)
+        _kernels._rates(0.7, hgt, v, out, quad)
         assert out[5] == pytest.approx(float(earth.gravity(0.7, hgt, model)), rel=1e-15)
     # the two differ by the second-order term only: 3 h²/a² γ0
     h = 1.0e4

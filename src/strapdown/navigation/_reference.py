@@ -1,9 +1,9 @@
-"""Plain-Python twins of :mod:`strapdown.algorithms._nav_kernels`, generic over the
-arithmetic.
+"""Plain-Python twins of :mod:`strapdown.navigation._kernels`, generic over the arithmetic.
 
 The same code runs on Python floats (the oracle the compiled kernels are tested against)
 and on mpmath numbers (the arbitrary-precision analysis of the sculling error law). It
-mirrors the kernels operation by operation; quaternion helpers come from
+mirrors the kernels operation by operation; the body increments' twins come from
+:mod:`strapdown.algorithms._velocity_reference`, quaternion helpers from
 :mod:`strapdown.algorithms._reference`.
 """
 
@@ -11,72 +11,7 @@ from __future__ import annotations
 
 from strapdown._core.backend import Backend
 from strapdown.algorithms._reference import update
-
-
-def cross(a, b):
-    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
-
-
-def axpy(c, x, y):
-    """y + c·x."""
-    return tuple(yi + c * xi for xi, yi in zip(x, y, strict=True))
-
-
-def rotation_comp(alpha, ups):
-    """υ + ½ α × υ + ⅙ α × (α × υ)."""
-    c = cross(alpha, ups)
-    cc = cross(alpha, c)
-    return tuple(u + 0.5 * a + b / 6 for u, a, b in zip(ups, c, cc, strict=True))
-
-
-def conventional_body(theta, dv, kc, ks, h, zero):
-    """Twin of :func:`strapdown.algorithms._nav_kernels.conventional_body_kernel`: lists of
-    (φ, Δv_b, ΔR_b) per update; ``kc``, ``ks`` nested lists (N × N)."""
-    n = len(kc)
-    z3 = (zero, zero, zero)
-    twelfth = (zero + 1) / 12
-    prev_t, prev_v = z3, z3
-    out = []
-    for u in range(len(theta) // n):
-        b = u * n
-        alpha, ups, scul, dr = z3, z3, z3, z3
-        for j in range(n):
-            scul = axpy(twelfth, cross(prev_t, dv[b + j]), scul)
-            scul = axpy(twelfth, cross(prev_v, theta[b + j]), scul)
-            alpha = axpy(1, theta[b + j], alpha)
-            ups = axpy(1, dv[b + j], ups)
-            prev_t, prev_v = tuple(theta[b + j]), tuple(dv[b + j])
-            if j < n - 1:
-                run = rotation_comp(alpha, ups)
-                dr = tuple(d + h * (r + s) for d, r, s in zip(dr, run, scul, strict=True))
-        phi, vel = alpha, rotation_comp(alpha, ups)
-        for i in range(n - 1):
-            for j in range(i + 1, n):
-                if kc[i][j] != 0:
-                    phi = axpy(kc[i][j], cross(theta[b + i], theta[b + j]), phi)
-                if ks[i][j] != 0:
-                    vel = axpy(ks[i][j], cross(theta[b + i], dv[b + j]), vel)
-                    vel = axpy(ks[i][j], cross(dv[b + i], theta[b + j]), vel)
-        out.append((phi, vel, tuple(d + h / 2 * v for d, v in zip(dr, vel, strict=True))))
-    return out
-
-
-def single_chain_body(theta, dv, tab_c, tab_s, h):
-    """Twin of :func:`strapdown.algorithms._nav_kernels.single_chain_body_kernel`."""
-    n = len(tab_c)
-    out = []
-    for k in range(len(theta)):
-        row = min(k, n - 1)
-        phi, vel = tuple(theta[k]), rotation_comp(theta[k], dv[k])
-        for m in range(1, row + 1):
-            cc, cs = tab_c[row][m - 1], tab_s[row][m - 1]
-            if cc != 0:
-                phi = axpy(cc, cross(theta[k - m], theta[k]), phi)
-            if cs != 0:
-                vel = axpy(cs, cross(theta[k - m], dv[k]), vel)
-                vel = axpy(cs, cross(dv[k - m], theta[k]), vel)
-        out.append((phi, vel, tuple(h / 2 * v for v in vel)))
-    return out
+from strapdown.algorithms._velocity_reference import axpy, cross
 
 
 def rotate(q, x):
@@ -90,7 +25,7 @@ def rotate(q, x):
 
 
 def inertial(body, period, q0, v0, p0, m: Backend):
-    """Twin of :func:`strapdown.algorithms._nav_kernels.inertial_kernel`: lists of q, v, p."""
+    """Twin of :func:`strapdown.navigation._kernels.inertial_kernel`: lists of q, v, p."""
     qs, vs, ps = [tuple(q0)], [tuple(v0)], [tuple(p0)]
     for phi, dvb, drb in body:
         q, v, p = qs[-1], vs[-1], ps[-1]
@@ -103,7 +38,7 @@ def inertial(body, period, q0, v0, p0, m: Backend):
 
 # ---------------------------------------------------------------------- WGS-84 navigation
 def earth_rates(lat, hgt, v, m: Backend, quad=1):
-    """Twin of :func:`strapdown.algorithms._nav_kernels._rates`: ω_in, gravity and
+    """Twin of :func:`strapdown.navigation._kernels._rates`: ω_in, gravity and
     Coriolis, (L̇, λ̇, ḣ) as one 9-tuple (``quad = 0``: linear height correction)."""
     from strapdown.truth import earth
 
@@ -149,7 +84,7 @@ def left_update(zeta, q, m: Backend):
 
 
 def earth_nav(body, period, pos0, v0, q0, m: Backend, quad=1):
-    """Twin of :func:`strapdown.algorithms._nav_kernels.earth_nav_kernel` on a list of
+    """Twin of :func:`strapdown.navigation._kernels.earth_nav_kernel` on a list of
     ``(φ, Δv_b)``: lists of positions, velocities and ``q_n_b`` (row 0 the initial state).
     The same equations; the navigation-frame rotation by its exponential (the kernel takes
     a series below |ζ|/2 = 1e-2, equal to rounding)."""

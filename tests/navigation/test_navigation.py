@@ -10,8 +10,7 @@ import math
 import numpy as np
 import pytest
 
-from strapdown.algorithms import _nav_kernels
-from strapdown.algorithms.navigation import navigate
+from strapdown.navigation import _kernels, navigate
 from strapdown.truth import earth
 from strapdown.truth.trajectory import EarthFlight, EarthSegment
 
@@ -33,12 +32,12 @@ def _run(flight, rate, n=1, structure="conventional", bias=None):
 
 
 def test_kernel_rates_are_the_earth_model():
-    assert (_nav_kernels._A, _nav_kernels._E2, _nav_kernels._OMEGA, _nav_kernels._GE,
-            _nav_kernels._GK, _nav_kernels._GM_RATIO) == (earth.A, earth.E2, earth.OMEGA,
+    assert (_kernels._A, _kernels._E2, _kernels._OMEGA, _kernels._GE,
+            _kernels._GK, _kernels._GM_RATIO) == (earth.A, earth.E2, earth.OMEGA,
                                                           earth.GE, earth.GK, earth.GM_RATIO)
     out = np.empty(9)
     v = np.array([80.0, -60.0, 5.0])
-    _nav_kernels._rates(0.7, 1234.0, v, out, 1.0)
+    _kernels._rates(0.7, 1234.0, v, out, 1.0)
     wie = earth.earth_rate(0.7)
     win = wie + earth.transport_rate(0.7, 1234.0, v)
     rn, re = earth.radii(0.7, 1234.0)
@@ -65,8 +64,8 @@ def _flight_inputs(fl: EarthFlight, structure: str, **extra):
 @pytest.mark.parametrize(("structure", "n"), [("conventional", 2), ("single-chain", 3)])
 def test_kernel_equals_plain_twin(structure, n):
     from strapdown._core.backend import NUMPY
-    from strapdown.algorithms import _nav_reference as ref
     from strapdown.algorithms.velocity import body_increments
+    from strapdown.navigation import _reference as ref
 
     fl = EarthFlight([EarthSegment(2.0), EarthSegment(4.0, 6.0, 8.0)], lat_deg=50.0,
                      speed=120.0, ramp=3.0)
@@ -163,7 +162,7 @@ def test_bad_initial_state():
 @pytest.mark.parametrize(("structure", "n"), [("conventional", 1), ("conventional", 3),
                                               ("single-chain", 1), ("single-chain", 4)])
 def test_stream_equals_navigate_bit_for_bit(structure, n):
-    from strapdown.algorithms.navigation import NavStream
+    from strapdown.navigation import NavStream
 
     fl = EarthFlight([EarthSegment(3.0), EarthSegment(3.0, 5.0, 4.0)], lat_deg=40.0,
                      speed=90.0, ramp=2.0)

@@ -9,8 +9,8 @@ import math
 import numpy as np
 import pytest
 
-from strapdown.algorithms.navigation import POLE_LIMIT_DEG, NavStream, navigate
 from strapdown.cli import main
+from strapdown.navigation import POLE_LIMIT_DEG, NavStream, navigate
 
 H = 0.01
 G = 9.80665
