@@ -92,3 +92,15 @@ def test_a_docstring_does_not_count_and_a_kernel_is_exempt(tmp_path):
 def test_the_package_itself_passes():
     res = _lint(ROOT / "src" / "strapdown", names=None)  # the registries' own names
     assert res.returncode == 0, res.stdout + res.stderr
+
+
+def test_the_designer_is_linted_like_everything_else(tmp_path):
+    """The allow-list is empty: a planted dispatch in design/ fails as anywhere outside the
+    model (the designer asks its target, layout and form objects)."""
+    sys.path.insert(0, str(SCRIPT.parent))
+    try:
+        import lint_model
+    finally:
+        sys.path.remove(str(SCRIPT.parent))
+    assert lint_model.ALLOWED == {}
+    assert _lint(_plant(tmp_path, "design/designer.py", DISPATCH)).returncode == 1

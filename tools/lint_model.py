@@ -15,9 +15,9 @@ Two rules, checked on the syntax tree of every ``.py`` file given (directories a
     exempt: a kernel is one loop the compiler fuses, and splitting it costs speed. A C
     template is text: it belongs in a template file, not a function body.
 
-Files the model does not own yet are exempt through :data:`ALLOWED` (path → rules), each
-entry with the reason; the list is to be emptied, not grown. A string that is another
-vocabulary's word and only happens to spell a registry name (a designer's target
+Files the model did not own yet were exempt through :data:`ALLOWED` (path → rules), each
+entry with the reason; the list is empty now and is not to grow again. A string that is
+another vocabulary's word and only happens to spell a registry name (a designer's target
 ``"coning"``) is marked on its line with ``# lint-model: <why>`` (:data:`PRAGMA`; the reason
 is required).
 
@@ -61,19 +61,10 @@ PRAGMA = "# lint-model:"
 KERNEL_DECORATORS = frozenset({"njit", "jit", "vectorize", "guvectorize", "cfunc",
                                "stencil", "generated_jit", "overload"})
 
-#: Files outside the model still allowed a rule, relative to ``src/strapdown``, with why.
-#: To be emptied: every entry is work left, not a licence.
-ALLOWED: dict[str, tuple[frozenset[str], str]] = {
-    # --- the designer (issue 26: coning-in-specific-force target being added)
-    "design/designer.py": (frozenset({"name-dispatch", "long-function"}),
-                           "designer forms, issue 26 velocity sets in progress"),
-    "design/optimize.py": (frozenset({"name-dispatch", "long-function"}),
-                           "designer, issue 26 velocity sets in progress"),
-    "design/shaped.py": (frozenset({"name-dispatch", "long-function"}),
-                         "designer, issue 26 velocity sets in progress"),
-    "design/finite_amplitude.py": (frozenset({"name-dispatch", "long-function"}),
-                                   "designer, issue 26 velocity sets in progress"),
-}
+#: Files outside the model allowed a rule, relative to ``src/strapdown``, with why
+#: (``{"design/x.py": (frozenset({"name-dispatch"}), "why")}``). Empty since the designer
+#: asks its own target, layout and form objects; an entry would be work left, not a licence.
+ALLOWED: dict[str, tuple[frozenset[str], str]] = {}
 
 
 def registry_names() -> frozenset[str]:

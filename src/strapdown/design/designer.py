@@ -68,7 +68,7 @@ lowest degrees first, then minimum norm) or ``"min-norm"``.
 from __future__ import annotations
 
 import functools
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from fractions import Fraction
 from itertools import pairwise
@@ -205,27 +205,49 @@ def _nodes(lo: int, hi: int) -> tuple[Fraction, ...]:
     return tuple(F(s) for s in range(lo, hi))
 
 
+def _each_pair(nodes, pairs):
+    """One free coefficient per pair."""
+    return [((k, F(1)),) for k in range(len(pairs))]
+
+
+def _lag_sums(nodes, pairs):
+    """One free coefficient per lag, spread evenly over the pairs of that lag."""
+    groups = []
+    for lag in sorted({nodes[j] - nodes[i] for i, j in pairs}):
+        members = [k for k, (i, j) in enumerate(pairs) if nodes[j] - nodes[i] == lag]
+        groups.append(tuple((k, F(1, len(members))) for k in members))
+    return groups
+
+
+@dataclass(frozen=True)
+class _LayoutRule:
+    """What a :data:`Layout` answers: whether its pairs are the lags with the last node
+    (ordered by lag m = 1, 2, …: ς_m multiplies s_{last−m} × s_last, Li & Zhang Table 3)
+    rather than every pair with a current node, and how it groups them."""
+
+    with_last: bool
+    groups: Callable[[Sequence[Fraction], list[tuple[int, int]]], list]
+
+
+_LAYOUT_RULES: dict[str, _LayoutRule] = {
+    "cross-with-last": _LayoutRule(True, _each_pair),
+    "lag": _LayoutRule(False, _lag_sums),
+    "all-pairs": _LayoutRule(False, _each_pair),
+}
+
+
 def _pairs_and_groups(nodes, layout, current_from, last):
     """Pairs whose later node is current; grouped by layout."""
+    rule = _LAYOUT_RULES.get(layout) if isinstance(layout, str) else None
+    if rule is None:
+        raise ValueError(f"unknown layout {layout!r}; choose one of {', '.join(LAYOUTS)}")
     idx = range(len(nodes))
-    if layout == "cross-with-last":
-        # ordered by lag m = 1, 2, …: ς_m multiplies s_{last−m} × s_last (Li & Zhang Table 3)
+    if rule.with_last:
         pairs = [(last - m, last) for m in range(1, last + 1)]
-        groups = [((k, F(1)),) for k in range(len(pairs))]
     else:
         pairs = [(i, j) for j in idx for i in idx if i < j and j >= current_from]
         pairs.sort(key=lambda p: (p[0], p[1]))
-        if layout == "all-pairs":
-            groups = [((k, F(1)),) for k in range(len(pairs))]
-        elif layout == "lag":
-            lags = sorted({nodes[j] - nodes[i] for i, j in pairs})
-            groups = []
-            for lag in lags:
-                members = [k for k, (i, j) in enumerate(pairs) if nodes[j] - nodes[i] == lag]
-                groups.append(tuple((k, F(1, len(members))) for k in members))
-        else:
-            raise ValueError(f"unknown layout {layout!r}; choose one of {', '.join(LAYOUTS)}")
-    return tuple(pairs), tuple(groups)
+    return tuple(pairs), tuple(rule.groups(nodes, pairs))
 
 
 def interval_structure(n: int, layout: Layout = "cross-with-last") -> Structure:
@@ -311,19 +333,28 @@ def three_period_structure() -> Structure:
 FORMS: tuple[Form, ...] = get_args(Form)
 
 
+def _interval_form(layout: Layout) -> Callable[[int, int | None], Structure]:
+    return lambda n, previous: interval_structure(n, layout)
+
+
+#: How each :data:`Form` builds its structure from N and ``previous`` (a layout: N
+#: increments in one interval, :func:`interval_structure`).
+_FORM_BUILDERS: dict[str, Callable[[int, int | None], Structure]] = {
+    **{layout: _interval_form(layout) for layout in LAYOUTS},
+    "single-chain": lambda n, previous: single_chain_structure(n),
+    "uncompressed": lambda n, previous: uncompressed_structure(
+        n, n if previous is None else previous),
+    "rate": lambda n, previous: rate_structure(n),
+    "rate-three": lambda n, previous: three_period_structure(),
+}
+
+
 def structure_by_name(form: Form, n: int, *, previous: int | None = None) -> Structure:
     """The structure a CLI ``--form`` names (``uncompressed`` defaults to N previous increments)."""
-    if form in LAYOUTS:
-        return interval_structure(n, form)
-    if form == "single-chain":
-        return single_chain_structure(n)
-    if form == "uncompressed":
-        return uncompressed_structure(n, n if previous is None else previous)
-    if form == "rate":
-        return rate_structure(n)
-    if form == "rate-three":
-        return three_period_structure()
-    raise ValueError(f"unknown form {form!r}; choose one of {', '.join(FORMS)}")
+    build = _FORM_BUILDERS.get(form) if isinstance(form, str) else None
+    if build is None:
+        raise ValueError(f"unknown form {form!r}; choose one of {', '.join(FORMS)}")
+    return build(n, previous)
 
 
 # ------------------------------------------------------------------ exact power series
@@ -631,7 +662,8 @@ class Design:
                                                              strict=True))
         return CoefficientSet(name or f"designed-{self.target}", n, mat,
                               tuple(tuple(r) for r in k), f"derived: {st.name}, {self.target}",
-                              self.target == "coning" and self.order == 2 * n, triples)
+                              _TARGET_RULES[self.target].classical_coning
+                              and self.order == 2 * n, triples)
 
     def algorithm(self) -> WindowedAlgorithm:
         """The derived algorithm in general windowed form (any structure; pair terms only:
@@ -774,6 +806,35 @@ def _frac(v) -> Fraction:
     return F(int(n), int(d))
 
 
+@dataclass(frozen=True)
+class _TargetRule:
+    """What a :data:`DesignTarget` answers: the error series it is measured on
+    (``series(structure, m, quadrature)`` → the uncorrected series and one per pair, powers
+    of Ωh up to ``m``), whether the coefficients are fitted to it (``fits_series``; else the
+    polynomial conditions alone, the series only measured), whether the classical-sculling
+    conditions are met with it power by power (``with_sculling``) and whether its order is
+    the classical-coning drift order (``classical_coning``: a set at order 2N is the
+    classical optimum)."""
+
+    series: Callable[[Structure, int, bool], tuple[list, list]]
+    fits_series: bool = True
+    with_sculling: bool = False
+    classical_coning: bool = False
+
+
+def _coning_target_series(st: Structure, m: int, quadrature: bool):
+    return _coning_series(st, m, quadrature=quadrature)
+
+
+_TARGET_RULES: dict[str, _TargetRule] = {
+    "coning": _TargetRule(_coning_target_series, classical_coning=True),
+    "polynomial": _TargetRule(_coning_target_series, fits_series=False),
+    "sculling": _TargetRule(lambda st, m, quadrature: _sculling_series(st, m)),
+    "coning-force": _TargetRule(lambda st, m, quadrature: _coning_force_series(st, m),
+                                with_sculling=True),
+}
+
+
 def derive(structure: Structure, *, target: DesignTarget = "coning",
            rule: DesignRule = "polynomial",
            quadrature: bool = True) -> Design:
@@ -814,12 +875,8 @@ def _derive(st: Structure, target: DesignTarget, rule: DesignRule, quadrature: b
         for k, mult in members:
             g[k][col] += mult
     m = 2 * ng + 2 * max(len(st.nodes), 2) + 9
-    if target == "sculling":
-        e0, pair_series = _sculling_series(st, m)
-    elif target == "coning-force":
-        e0, pair_series = _coning_force_series(st, m)
-    else:
-        e0, pair_series = _coning_series(st, m, quadrature=quadrature)
+    aim = _TARGET_RULES[target]
+    e0, pair_series = aim.series(st, m, quadrature)
     grp_series = [[sum(g[k][col] * pair_series[k][p] for k in range(npair)) for p in range(m + 1)]
                   for col in range(ng)]
     con_rows = [[grp_series[c][p] for c in range(ng)] for p in range(m + 1)]
@@ -827,13 +884,13 @@ def _derive(st: Structure, target: DesignTarget, rule: DesignRule, quadrature: b
     poly_rows_p, poly_rhs, _ = _poly_conditions(st)
     poly_rows = [[sum(r[k] * g[k][c] for k in range(npair)) for c in range(ng)]
                  for r in poly_rows_p]
-    if target == "coning-force":  # sculling and force conditions, power by power
+    if aim.with_sculling:  # sculling and force conditions, power by power
         e_s, p_s = _sculling_series(st, m)
         rows_s = [[sum(g[k][c] * p_s[k][p] for k in range(npair)) for c in range(ng)]
                   for p in range(m + 1)]
         con_rows = [r for p in range(m + 1) for r in (rows_s[p], con_rows[p])]
         con_rhs = [v for p in range(m + 1) for v in (-e_s[p], con_rhs[p])]
-    if target != "polynomial":
+    if aim.fits_series:
         a, b = _prefix_solve(con_rows, con_rhs)
         conditions = len(a)
         if rule == "polynomial":
@@ -845,5 +902,5 @@ def _derive(st: Structure, target: DesignTarget, rule: DesignRule, quadrature: b
     ug = [_frac(v) for v in u]
     coeffs = tuple(sum((g[k][c] * ug[c] for c in range(ng)), F(0)) for k in range(npair))
     order, const = _leading(st, coeffs, e0, pair_series, m)
-    rule_used = rule if target != "polynomial" else "min-norm"
+    rule_used = rule if aim.fits_series else "min-norm"
     return Design(st, target, rule_used, coeffs, order, const, quadrature, conditions)
