@@ -20,9 +20,11 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--samples", type=int, default=10_000_000)
     p.add_argument("--ekf-samples", type=int, default=1_000_000)
     p.add_argument("--stream-samples", type=int, default=100_000_000)
+    p.add_argument("--earth-samples", type=int, default=1_000_000,
+                   help="increments of the Earth navigation benchmark")
     a = p.parse_args(argv)
     recs = bench.run_benchmarks(a.samples, stream_samples=a.stream_samples,
-                                ekf_samples=a.ekf_samples,
+                                ekf_samples=a.ekf_samples, earth_samples=a.earth_samples,
                                 log=lambda line: print(line, file=sys.stderr))
     write_text(Path(a.out), json.dumps(recs, indent=2))
     for r in recs:

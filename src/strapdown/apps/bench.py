@@ -25,6 +25,12 @@ increments (conventional N = 2 and the single chain N = 2), and
 the same motion at the same rate; the record ``sculling-ours-over-smsfusion`` gives the
 throughput ratio ours (conventional N = 2) / smsfusion.
 
+The Earth navigation (:func:`strapdown.navigation.navigate`, conventional N = 2 and the
+single chain N = 2, WGS-84, the default velocity set) runs on a synthetic log of
+``earth_samples`` increments (default ``min(nav_samples, 10⁶)``: a level vehicle at rest at
+40° N with small vibrations, 1 kHz), reported as increments per second (the body
+increments and the Earth step together).
+
 With a ``log``, each benchmark announces itself (``[k/total] name``) before it
 runs. A peer that is not installed is not dropped silently: its record has
 ``skipped``, saying which package is missing and the extra that installs it.
@@ -230,6 +236,39 @@ def _sculling(nav_samples: int, peer_samples: int, repeat: int) -> list[_Job]:
     return jobs
 
 
+#: The Earth navigation benchmark's log: sample interval (s), latitude (rad), height (m).
+EARTH_BENCH = (0.001, 0.7, 100.0)
+
+
+def _earth_log(samples: int) -> tuple[np.ndarray, np.ndarray]:
+    """Gyro (rad) and accelerometer (m/s) increments of a level vehicle at rest at
+    :data:`EARTH_BENCH` (the Earth's rate and normal gravity, NED body axes) with small
+    zero-mean vibrations of its rates and specific force."""
+    from strapdown.truth import earth
+
+    h, lat, height = EARTH_BENCH
+    t = np.arange(samples) * h
+    w = earth.earth_rate(lat) + np.column_stack([
+        2e-3 * np.sin(3.1 * t), 1e-3 * np.cos(2.3 * t), 5e-4 * np.sin(1.7 * t)])
+    f = np.array([0.0, 0.0, -float(earth.gravity(lat, height))]) + np.column_stack([
+        0.05 * np.sin(2.9 * t), 0.03 * np.cos(1.3 * t), 0.02 * np.sin(4.1 * t)])
+    return w * h, f * h
+
+
+def _earth(samples: int, repeat: int) -> list[_Job]:
+    """Jobs of the Earth navigation (:func:`strapdown.navigation.navigate`) on
+    :func:`_earth_log`: conventional N = 2 and the single chain N = 2."""
+    import functools
+
+    from strapdown.navigation import navigate
+
+    h, lat, height = EARTH_BENCH
+    g, a = _earth_log(samples)
+    return [_Job(f"nav-earth-N2-{st}", None, functools.partial(
+        navigate, g, a, 2, h=h, lat=lat, lon=0.1, height=height, structure=st), samples,
+        repeat) for st in ("conventional", "single-chain")]
+
+
 def _sculling_ratio(recs: list[dict]) -> dict:
     """``sculling-ours-over-smsfusion``: throughput ours (conventional N = 2) / smsfusion on
     the same sculling motion; ``skipped`` when either record has no rate."""
@@ -291,11 +330,14 @@ def _stream_memory(total, structure, chunk=1 << 16):
 def run_benchmarks(samples: int = 10_000_000, peer_samples: int = 20_000, repeat: int = 3,
                    stream_samples: int = 100_000_000, ekf_samples: int = 1_000_000, *,
                    nav_samples: int = 2_000_000, compiled_samples: int | None = None,
+                   earth_samples: int | None = None,
                    log: Callable[[str], None] | None = None) -> list[dict]:
     """All benchmark records (see the module docstring); ``nav_samples=0`` skips the
-    velocity/sculling benchmarks. ``compiled_samples``: samples of the compiled AHRS and
-    its compiled peers (default ``ekf_samples``, or none below :data:`COMPILED_MIN`
-    samples, where a compiled program's timing would be mostly its start-up).
+    velocity/sculling and Earth navigation benchmarks; ``earth_samples`` the Earth
+    navigation's increments (default ``min(nav_samples, 10⁶)``). ``compiled_samples``:
+    samples of the compiled AHRS and its compiled peers (default ``ekf_samples``, or none
+    below :data:`COMPILED_MIN` samples, where a compiled program's timing would be mostly
+    its start-up).
 
     ``log`` receives ``[k/total] name`` before each benchmark runs, and one line naming
     the peers that are skipped and why, before the first.
@@ -304,7 +346,9 @@ def run_benchmarks(samples: int = 10_000_000, peer_samples: int = 20_000, repeat
     floor_job, ours = _ours(samples, repeat)
     jobs = [floor_job, *ours, *_peers(peer_samples), *(_ahrs(ekf_samples, repeat)
                                                         if ekf_samples else ()),
-            *(_sculling(nav_samples, peer_samples, repeat) if nav_samples else ())]
+            *(_sculling(nav_samples, peer_samples, repeat) if nav_samples else ()),
+            *(_earth(min(nav_samples, 1_000_000) if earth_samples is None else earth_samples,
+                     repeat) if nav_samples else ())]
     streams = ("conventional", "realtime") if stream_samples else ()
     skipped = [j for j in jobs if j.fn is None]
     if skipped:

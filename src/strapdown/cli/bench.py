@@ -37,7 +37,8 @@ def _arguments(p: argparse.ArgumentParser) -> None:
                    help="samples for the AHRS EKF and its peers (0 skips them)")
     p.add_argument("--nav-samples", type=int, default=2_000_000,
                    help="samples of the velocity/sculling update (ours; smsfusion gets "
-                   "--peer-samples of the same motion); 0 skips them")
+                   "--peer-samples of the same motion) and, up to 10^6, of the Earth "
+                   "navigation; 0 skips them")
     p.add_argument("--repeat", type=int, default=3, help="timed runs; the best is reported")
     p.add_argument("--json", action="store_true", help="print the records as JSON")
     progress_args(p, "a line as each benchmark starts")
