@@ -12,8 +12,8 @@ a small function that numba inlines into the loop (``inline="always"``):
 2. :func:`_fold_rest_samples` — the rest detector's moving averages;
 3. :func:`_propagate_covariance` and :func:`_add_process_noise` — ``P ← Φ P Φᵀ + Q``,
    with a tilt noise proportional to the rotation rate;
-4. :func:`_rest_detect` and :func:`_rest_model` — the zero-rate bias update, once rest
-   has lasted ``rest_min_s``;
+4. :func:`_rest_detect`, :func:`_rest_still` and :func:`_rest_model` — the zero-rate bias
+   update, once rest has lasted ``rest_min_s``;
 5. the accelerometer: recovery (:func:`_acc_recovery`), then the model of
    ``AhrsConfig.acc_model`` — :func:`_acc_lowpass_model` (Laidig & Seel (2023),
    VQF's idea: the specific force in the almost-inertial reference frame through a
@@ -660,6 +660,24 @@ def _rest_detect(ema_n, rest_alpha, params, gm, g2, am, a2):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
+def _rest_still(k, x, acc, h, is_rate, params, gm, am):
+    """Stage 4, the latest sample: its gyro within ``rest_gyro`` and its specific force
+    within ``rest_acc`` of the moving averages (the norm of the deviation; VQF's per-sample
+    test, Laidig & Seel (2023), Sec. 2.6). The averages lag by ``rest_tau``: a motion that
+    starts slowly (a spin-up) keeps their variance low for a while and moves their mean
+    with it, so without this test the rest update learns the first degrees per second of
+    the motion as gyro bias, which no later measurement can undo."""
+    kk = min(k, x.shape[0] - 1) if is_rate else k - 1
+    dg = 0.0
+    da = 0.0
+    for a in range(3):
+        wv = x[kk, a] if is_rate else x[kk, a] / h
+        dg += (wv - gm[a]) ** 2
+        da += (acc[k, a] - am[a]) ** 2
+    return dg < params.rest_gyro ** 2 and da < params.rest_acc ** 2
+
+
+@njit(cache=True, inline="always", error_model="numpy")
 def _rest_model(params, bias, gm, dx, y):
     """Stage 4, measurement: the zero-rate measurement of the gyro bias (at rest the
     gyro's mean is its bias; ``H = [0, I, 0]``, fixed; ``R = rest_noise²/T I``): the
@@ -1196,6 +1214,7 @@ def ekf_kernel(sensors, prop, window, params, init, out):
         tk = k * h
         # stage 4: rest
         acc_quiet, at_rest = _rest_detect(ema_n, rest_alpha, params, gm, g2, am, a2)
+        at_rest = at_rest and _rest_still(k, x, acc, h, is_rate, params, gm, am)
         rest_since = (rest_since if rest_since >= 0.0 else tk) if at_rest else -1.0
         if params.rest_update and at_rest and tk - rest_since >= params.rest_min_s:
             _rest_model(params, bias, gm, dx, y3)
