@@ -217,6 +217,14 @@ class AhrsConfig:
         frame (``ṁ = −ω × m``), averaged over ``mag_delay_tau_s``.
     mag_delay_max_s, mag_delay_tau_s : float
         Its largest candidate and averaging time, s. Defaults 0.02, 10.
+    mag_delay_z : float
+        The estimator changes the delay in use only when the best candidate's mean
+        residual is lower by ``z`` standard deviations of that difference (estimated as
+        for white noise, ``(4/3) z² res_min / N``); otherwise the delay stays. A steady
+        spin, whose rate barely changes over the candidates, cannot tell the delays apart,
+        and a noise-picked wrong delay turned the field by ω times the error (spin-coning:
+        1.4° heading excursions). Default 0.5 (the white-noise formula overstates the
+        spread: the field's differenced noise telescopes over slowly varying rates).
     gyro_sample : {"interval", "point"}
         What a gyro sample is. ``interval`` (default, CV): the mean rate over the sample
         period that ends at its time stamp — what a MEMS IMU's decimation filter
@@ -332,6 +340,7 @@ class AhrsConfig:
     estimate_mag_delay: bool = True
     mag_delay_max_s: float = 0.02
     mag_delay_tau_s: float = 10.0
+    mag_delay_z: float = 0.5
     gyro_sample: str = "interval"
     mag_sample: str = "point"
     latency_s: float = 0.0
