@@ -184,6 +184,7 @@ class Params(NamedTuple):
     lp_a1: float  #: denominator (a0 = 1),
     lp_a2: float
     lp_init_n: int  #: epochs averaged before the filter starts
+    lp_settle: int  #: the low-pass model updates from epoch lp_init_n + lp_settle (0 or −lp_init_n)
     dyn_k: float  #: gain per epoch of the motion acceleration's moving mean square
     dyn_k2: float  #: gain per epoch of the slow mean of the low-passed specific force
     mc_b0: float  #: the low-pass of the field's norm and dip, likewise
@@ -1259,7 +1260,9 @@ def ekf_kernel(sensors, prop, window, params, init, out):
                 # low-passed specific force is then longer than gravity
                 disturbed = params.gating and not _lowpass_plausible(lp, params)
                 ok = False
-                if not disturbed:
+                # lp_settle = 0: no update while the low-pass is still averaging its first
+                # lp_init_n epochs (a running mean of a few samples in motion is not gravity)
+                if not disturbed and lp_n >= params.lp_init_n + params.lp_settle:
                     nis_acc, ok = _gated_update(P, H_lp, 3 if nx == 6 else nx,
                                                 _lowpass_variance(params, dyn2, T), y2,
                                                 params.acc_gate_lowpass, params.gating, force,

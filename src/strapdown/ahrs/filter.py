@@ -217,6 +217,14 @@ class AhrsConfig:
         frame (``ṁ = −ω × m``), averaged over ``mag_delay_tau_s``.
     mag_delay_max_s, mag_delay_tau_s : float
         Its largest candidate and averaging time, s. Defaults 0.02, 10.
+    acc_lowpass_settle : bool
+        No low-pass accelerometer update until the low-pass has averaged its first
+        ``acc_lowpass_s`` (default off; the offline backward pass sets it). During those
+        epochs the low-pass output is a running mean of a few samples, which in motion is
+        not gravity, while its motion-power term is still zero: a pass started in motion
+        from an already-converged estimate (the backward pass, at the record's end) was
+        dragged by degrees (spin-coning: 6.9°), and the two-filter combination, trusting
+        its small covariance, took it.
     mag_delay_z : float
         The estimator changes the delay in use only when the best candidate's mean
         residual is lower by ``z`` standard deviations of that difference (estimated as
@@ -341,6 +349,7 @@ class AhrsConfig:
     mag_delay_max_s: float = 0.02
     mag_delay_tau_s: float = 10.0
     mag_delay_z: float = 0.5
+    acc_lowpass_settle: bool = False
     gyro_sample: str = "interval"
     mag_sample: str = "point"
     latency_s: float = 0.0
@@ -637,6 +646,8 @@ def _derived(cfg: AhrsConfig, ref, use_mag: bool, h: float, te: float,
             **dict(zip(("lp_b0", "lp_b1", "lp_b2", "lp_a1", "lp_a2"), lp, strict=True)),
             **dict(zip(("mc_b0", "mc_b1", "mc_b2", "mc_a1", "mc_a2"), mc, strict=True)),
             "lp_init_n": max(1, math.ceil(cfg.acc_lowpass_s / te - 1e-9)),
+            "lp_settle": (0 if cfg.acc_lowpass_settle
+                          else -max(1, math.ceil(cfg.acc_lowpass_s / te - 1e-9))),
             "mc_init_n": max(1, math.ceil(cfg.mag_current_s / te - 1e-9)),
             "dyn_k": 1.0 - math.exp(-te / cfg.acc_lowpass_s),
             "dyn_k2": 1.0 - math.exp(-te / (K.MOTION_SLOW * cfg.acc_lowpass_s)),
@@ -869,10 +880,11 @@ def _backward(rec, acc, mag, have_mag: bool, cfg: AhrsConfig, algorithm: str, fw
     rec_b = replace(rec, omega=np.ascontiguousarray(-omega[::-1]))
     # started from the forward pass's last estimate, with its uncertainty (not the
     # initial one: the record's end is rarely a rest, and a start-up uncertainty there let
-    # the first seconds of motion pull the bias by degrees per second)
+    # the first seconds of motion pull the bias by degrees per second); and no low-pass
+    # accelerometer update until its low-pass has settled (acc_lowpass_settle)
     sig_att = math.sqrt(float(np.max(np.linalg.eigvalsh(fwd.attitude_cov[-1]))))
     sig_bias = math.sqrt(float(np.max(fwd.bias_var[-1])))
-    cfg_b = replace(cfg, estimate_mag_delay=False, mag_delay_s=0.0,
+    cfg_b = replace(cfg, estimate_mag_delay=False, mag_delay_s=0.0, acc_lowpass_settle=True,
                     mag_reject_s=cfg.offline_mag_reject_s,
                     attitude_sigma0=max(sig_att, 1e-4), gyro_bias_sigma0=max(sig_bias, 1e-6))
     out, epoch = _filter(rec_b, np.ascontiguousarray(acc[::-1]), np.ascontiguousarray(mag_b),
