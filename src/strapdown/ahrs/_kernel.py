@@ -1261,8 +1261,9 @@ def ekf_kernel(sensors, prop, window, params, init, out):
                 disturbed = params.gating and not _lowpass_plausible(lp, params)
                 ok = False
                 # lp_settle = 0: no update while the low-pass is still averaging its first
-                # lp_init_n epochs (a running mean of a few samples in motion is not gravity)
-                if not disturbed and lp_n >= params.lp_init_n + params.lp_settle:
+                # lp_init_n epochs unless the accelerometer is quiet (a running mean of a
+                # few samples in motion is not gravity)
+                if not disturbed and (acc_quiet or lp_n >= params.lp_init_n + params.lp_settle):
                     nis_acc, ok = _gated_update(P, H_lp, 3 if nx == 6 else nx,
                                                 _lowpass_variance(params, dyn2, T), y2,
                                                 params.acc_gate_lowpass, params.gating, force,

@@ -219,7 +219,8 @@ class AhrsConfig:
         Its largest candidate and averaging time, s. Defaults 0.02, 10.
     acc_lowpass_settle : bool
         No low-pass accelerometer update until the low-pass has averaged its first
-        ``acc_lowpass_s`` (default off; the offline backward pass sets it). During those
+        ``acc_lowpass_s``, unless the accelerometer is quiet (the rest detector's test)
+        (default off; the offline backward pass sets it). During those
         epochs the low-pass output is a running mean of a few samples, which in motion is
         not gravity, while its motion-power term is still zero: a pass started in motion
         from an already-converged estimate (the backward pass, at the record's end) was
@@ -409,7 +410,7 @@ _MAY_BE_INFINITE = ("mag_reject_s", "offline_mag_reject_s")
 _ANY_SIGN = ("declination_deg",)
 _NON_NEGATIVE = ("lever_arm", "acc_motion_leak", "tilt_rate_noise", "heading_rate_noise",
                  "mag_reject_s", "rest_min_s", "mag_delay_s", "latency_s", "mag_delay_max_s",
-                 "mag_disturbed_power", "offline_mag_reject_s")
+                 "mag_disturbed_power", "offline_mag_reject_s", "mag_delay_z")
 
 
 @dataclass(frozen=True)
