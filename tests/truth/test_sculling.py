@@ -70,9 +70,12 @@ def test_arbitrary_precision_against_mpmath_quadrature(name):
         for k in range(3):
             ref = mpmath.quad(lambda s, k=k: _f_nav_mp(mo, s)[k], mpmath.linspace(0, t1, 9))
             assert abs(v[k] - ref) < mpmath.mpf(10) ** -24
-        # position: ṗ = v, by quadrature of the closed-form velocity
+        # position: ṗ = v, by quadrature of the closed-form velocity (Gauss-Legendre: the
+        # integrand is smooth, so it converges in 180 evaluations where tanh-sinh took 500, to
+        # the same reference at 30 digits)
         p = mo.position_mp(t1)
-        ref = mpmath.quad(lambda s: mo.velocity_mp(s)[2], mpmath.linspace(0, t1, 5))
+        ref = mpmath.quad(lambda s: mo.velocity_mp(s)[2], mpmath.linspace(0, t1, 5),
+                          method="gauss-legendre")
         assert abs(p[2] - ref) < mpmath.mpf(10) ** -24
         # gyro increment = ∫ rate; rate = 2 q* ⊗ q̇ (numerical derivative of the attitude)
         t0, t2 = mpmath.mpf("0.41"), mpmath.mpf("0.47")
