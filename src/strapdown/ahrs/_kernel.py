@@ -200,6 +200,7 @@ class Params(NamedTuple):
     mag_delay_alpha: float  #: its averaging gain per sample
     mag_delay_z: float  #: its switching threshold, standard deviations (:func:`_delay_choice`)
     store_covariance: bool  #: write attitude_cov and bias_var (the offline combination)
+    heading_bridge_noise: bool  #: AhrsConfig.heading_bridge_noise
     meas_lead: float  #: how far the magnetometer's samples lead the attitude they update, s
     #: (half a period for point field samples beside interval gyro samples; :func:`_at_state_time`)
 
@@ -615,16 +616,21 @@ def _propagate_covariance(P, phi, T, decay, singer, A, M):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _add_process_noise(P, C, phi, T, qg, qb, qa, qab, params, singer):
+def _add_process_noise(P, C, phi, T, qg, qb, qa, qab, params, singer, unobserved):
     """Stage 3: ``P += Q``. The attitude gets the gyro's white noise and, for the gyro's
     scale-factor and misalignment errors, ``tilt_rate_noise² |ω|² T`` on the two tilt
     axes (horizontal in the reference frame: ``I − c cᵀ`` in the body frame with
     c = C₃ᵀ, the vertical) and ``heading_rate_noise² |ω|² T`` on the heading (``c cᵀ``):
     a fast rotation lets the accelerometer correct tilt sooner, and the heading's
-    uncertainty grows with the rotation while the field is rejected."""
+    uncertainty grows with the rotation while the field is rejected. ``unobserved`` (the
+    last epoch rejected a disturbed field, with ``heading_bridge_noise``): the heading
+    takes at least the tilt's rate noise — the gyro's rate errors do not know which axis
+    is vertical, and with no field they accumulate about the vertical unchecked."""
     w2 = (phi[0] ** 2 + phi[1] ** 2 + phi[2] ** 2) / T
     qs = params.tilt_rate_noise ** 2 * w2
-    qv = params.heading_rate_noise ** 2 * w2 - qs
+    hr = max(params.tilt_rate_noise, params.heading_rate_noise) if unobserved else \
+        params.heading_rate_noise
+    qv = hr ** 2 * w2 - qs
     for r in range(3):
         for c in range(3):
             P[r, c] += ((qg + qs) if r == c else 0.0) + qv * C[2, r] * C[2, c]
@@ -1205,6 +1211,7 @@ def ekf_kernel(sensors, prop, window, params, init, out):
     rest_since = -1.0  # start of the current run of rest detections (−1: none)
     acc_bad_since = -1.0  # start of the current run of rejections (−1: none)
     mag_bad_since = -1.0
+    heading_unobserved = False  # the last epoch rejected a disturbed field (heading_bridge_noise)
     e = 0
     # start-up outputs of the sliding scheme (samples 1 … lag−1 by single-period steps)
     n_start = lag - 1 if lag > 1 else 0
@@ -1230,7 +1237,7 @@ def ekf_kernel(sensors, prop, window, params, init, out):
         _dcm(q, C)
         decay, qg, qb, qa, qab = _process_noise(T, params)
         _propagate_covariance(P, phi, T, decay, singer, A, M)
-        _add_process_noise(P, C, phi, T, qg, qb, qa, qab, params, singer)
+        _add_process_noise(P, C, phi, T, qg, qb, qa, qab, params, singer, heading_unobserved)
         flags = 0
         dx[:] = 0.0
         tk = k * h
@@ -1324,6 +1331,7 @@ def ekf_kernel(sensors, prop, window, params, init, out):
                 flags |= bits
             elif dist:
                 ms[M_REJECT] += T
+            heading_unobserved = params.heading_bridge_noise and dist and (flags & F_MAG_USED) == 0
         # stage 7: reset
         _reset((e if step >= n_start else step + 1) % lag, q, ring, bias, accel, acc_bias, P,
                C, dx, eps, singer)

@@ -226,6 +226,17 @@ class AhrsConfig:
         from an already-converged estimate (the backward pass, at the record's end) was
         dragged by degrees (spin-coning: 6.9°), and the two-filter combination, trusting
         its small covariance, took it.
+    heading_bridge_noise : bool
+        While a disturbed field is rejected, the heading's process noise is at least the
+        tilt's rate noise, ``tilt_rate_noise² |ω|² T``: the gyro's scale-factor and
+        misalignment errors act about the vertical as about the horizontal axes, and with
+        the field rejected nothing bounds them (on BROAD's attached-magnet trials the gyro
+        alone drifted 14° in heading over a 55 s disturbance while the covariance claimed
+        0.56°). Default off; :func:`offline_ekf`'s backward pass sets it: it bridges every
+        disturbance on the gyro alone (``offline_mag_reject_s``), and the two-filter
+        combination weighs it by this covariance. (On in the causal filter, the grown
+        variance made the disturbed field, used de-weighted after ``mag_reject_s``, pull
+        the heading by degrees.)
     mag_delay_z : float
         The estimator changes the delay in use only when the best candidate's mean
         residual is lower by ``z`` standard deviations of that difference (estimated as
@@ -351,6 +362,7 @@ class AhrsConfig:
     mag_delay_tau_s: float = 10.0
     mag_delay_z: float = 0.5
     acc_lowpass_settle: bool = False
+    heading_bridge_noise: bool = False
     gyro_sample: str = "interval"
     mag_sample: str = "point"
     latency_s: float = 0.0
@@ -882,11 +894,12 @@ def _backward(rec, acc, mag, have_mag: bool, cfg: AhrsConfig, algorithm: str, fw
     # started from the forward pass's last estimate, with its uncertainty (not the
     # initial one: the record's end is rarely a rest, and a start-up uncertainty there let
     # the first seconds of motion pull the bias by degrees per second); and no low-pass
-    # accelerometer update until its low-pass has settled (acc_lowpass_settle)
+    # accelerometer update until its low-pass has settled (acc_lowpass_settle); its heading
+    # covariance grows with the rotation while it bridges a disturbance (heading_bridge_noise)
     sig_att = math.sqrt(float(np.max(np.linalg.eigvalsh(fwd.attitude_cov[-1]))))
     sig_bias = math.sqrt(float(np.max(fwd.bias_var[-1])))
     cfg_b = replace(cfg, estimate_mag_delay=False, mag_delay_s=0.0, acc_lowpass_settle=True,
-                    mag_reject_s=cfg.offline_mag_reject_s,
+                    heading_bridge_noise=True, mag_reject_s=cfg.offline_mag_reject_s,
                     attitude_sigma0=max(sig_att, 1e-4), gyro_bias_sigma0=max(sig_bias, 1e-6))
     out, epoch = _filter(rec_b, np.ascontiguousarray(acc[::-1]), np.ascontiguousarray(mag_b),
                          have_mag, cfg_b, algorithm, fwd.q[-1], -fwd.gyro_bias[-1], ref,
