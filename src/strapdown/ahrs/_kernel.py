@@ -616,20 +616,21 @@ def _propagate_covariance(P, phi, T, decay, singer, A, M):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _add_process_noise(P, C, phi, T, qg, qb, qa, qab, params, singer, unobserved):
+def _add_process_noise(P, C, phi, T, qg, qb, qa, qab, params, singer, unobserved, disturbed):
     """Stage 3: ``P += Q``. The attitude gets the gyro's white noise and, for the gyro's
     scale-factor and misalignment errors, ``tilt_rate_noise² |ω|² T`` on the two tilt
     axes (horizontal in the reference frame: ``I − c cᵀ`` in the body frame with
-    c = C₃ᵀ, the vertical) and ``heading_rate_noise² |ω|² T`` on the heading (``c cᵀ``):
-    a fast rotation lets the accelerometer correct tilt sooner, and the heading's
-    uncertainty grows with the rotation while the field is rejected. ``unobserved`` (the
+    c = C₃ᵀ, the vertical) and ``heading_rate_noise² |ω|² T`` on the heading (``c cᵀ``)
+    unless the last epoch found the field disturbed (``disturbed``): a fast rotation lets
+    the accelerometer correct tilt sooner and the field correct the heading sooner, while
+    a disturbed field, used de-weighted, does not gain weight with the rotation. ``unobserved`` (the
     last epoch rejected a disturbed field, with ``heading_bridge_noise``): the heading
     takes at least the tilt's rate noise — the gyro's rate errors do not know which axis
     is vertical, and with no field they accumulate about the vertical unchecked."""
     w2 = (phi[0] ** 2 + phi[1] ** 2 + phi[2] ** 2) / T
     qs = params.tilt_rate_noise ** 2 * w2
-    hr = max(params.tilt_rate_noise, params.heading_rate_noise) if unobserved else \
-        params.heading_rate_noise
+    hr = max(params.tilt_rate_noise, params.heading_rate_noise) if unobserved else (
+        0.0 if disturbed else params.heading_rate_noise)
     qv = hr ** 2 * w2 - qs
     for r in range(3):
         for c in range(3):
@@ -1212,6 +1213,7 @@ def ekf_kernel(sensors, prop, window, params, init, out):
     acc_bad_since = -1.0  # start of the current run of rejections (−1: none)
     mag_bad_since = -1.0
     heading_unobserved = False  # the last epoch rejected a disturbed field (heading_bridge_noise)
+    mag_dist_prev = False  # the last epoch found the field disturbed
     e = 0
     # start-up outputs of the sliding scheme (samples 1 … lag−1 by single-period steps)
     n_start = lag - 1 if lag > 1 else 0
@@ -1237,7 +1239,8 @@ def ekf_kernel(sensors, prop, window, params, init, out):
         _dcm(q, C)
         decay, qg, qb, qa, qab = _process_noise(T, params)
         _propagate_covariance(P, phi, T, decay, singer, A, M)
-        _add_process_noise(P, C, phi, T, qg, qb, qa, qab, params, singer, heading_unobserved)
+        _add_process_noise(P, C, phi, T, qg, qb, qa, qab, params, singer, heading_unobserved,
+                           mag_dist_prev)
         flags = 0
         dx[:] = 0.0
         tk = k * h
@@ -1332,6 +1335,7 @@ def ekf_kernel(sensors, prop, window, params, init, out):
             elif dist:
                 ms[M_REJECT] += T
             heading_unobserved = params.heading_bridge_noise and dist and (flags & F_MAG_USED) == 0
+            mag_dist_prev = dist
         # stage 7: reset
         _reset((e if step >= n_start else step + 1) % lag, q, ring, bias, accel, acc_bias, P,
                C, dx, eps, singer)
