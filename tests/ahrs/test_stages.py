@@ -227,17 +227,30 @@ def test_process_noise_terms(k):
 @pytest.mark.parametrize("nx, singer", [(6, False), (9, True), (12, True), (9, False)])
 def test_add_process_noise_splits_tilt_and_heading(k, nx, singer):
     """The attitude noise is σ_g² T plus tilt_rate_noise² |ω|² T across the reference
-    vertical (the body-frame c = C₃ᵀ) and heading_rate_noise² |ω|² T along it."""
+    vertical (the body-frame c = C₃ᵀ) and heading_rate_noise² |ω|² T along it (none
+    after a disturbed field; at least the tilt's while a bridging pass rejects one)."""
     p = _params_of(gyro_noise=2e-3, tilt_rate_noise=4e-3, heading_rate_noise=1e-2)
     T, phi = 0.01, np.array([0.02, 0.01, -0.03])
     qg, qb, qa, qab = 4e-6 * T, 1e-10, 3e-3, 2e-9
     P = np.zeros((nx, nx))
-    k._add_process_noise(P, C_HAT, phi, T, qg, qb, qa, qab, p, singer)
+    k._add_process_noise(P, C_HAT, phi, T, qg, qb, qa, qab, p, singer, False, False)
     w2 = phi @ phi / T**2
     c = C_HAT[2]
     assert P[:3, :3] @ c == pytest.approx((qg + 1e-4 * w2 * T) * c, rel=1e-12)
     horiz = np.cross(c, [1.0, 0.0, 0.0])
     assert P[:3, :3] @ horiz == pytest.approx((qg + 1.6e-5 * w2 * T) * horiz, rel=1e-12)
+    # the last epoch found the field disturbed: no heading rate noise; a rejected one in
+    # a bridging pass (heading_bridge_noise): at least the tilt's
+    for unobserved, disturbed, hv in ((False, True, 0.0), (True, True, 1e-4)):
+        Pd = np.zeros((nx, nx))
+        k._add_process_noise(Pd, C_HAT, phi, T, qg, qb, qa, qab, p, singer, unobserved,
+                             disturbed)
+        assert Pd[:3, :3] @ c == pytest.approx((qg + hv * w2 * T) * c, rel=1e-12, abs=1e-20)
+        assert Pd[:3, :3] @ horiz == pytest.approx((qg + 1.6e-5 * w2 * T) * horiz, rel=1e-12)
+    pb = _params_of(gyro_noise=2e-3, tilt_rate_noise=4e-3, heading_rate_noise=0.0)
+    Pb = np.zeros((nx, nx))
+    k._add_process_noise(Pb, C_HAT, phi, T, qg, qb, qa, qab, pb, singer, True, True)
+    assert Pb[:3, :3] @ c == pytest.approx((qg + 1.6e-5 * w2 * T) * c, rel=1e-12)
     diag = np.diag(P)
     assert np.all(diag[3:6] == qb)
     assert np.all(diag[6:9] == (qa if singer else (qab if nx == 9 else 0)))
