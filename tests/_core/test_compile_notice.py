@@ -71,8 +71,12 @@ def test_cli_says_it_compiles_on_first_use_only(tmp_path):
 
 
 def test_sweep_workers_say_it_once_for_the_pool(tmp_path):
+    # Four cases of the rotation-vector family: both workers start on one at once and both
+    # compile its kernels cold. rk4 and rate-three cost seconds of compiling and made the
+    # check no stricter: with a flag per worker planted, this scenario printed the line
+    # twice in 3 runs of 3, the four-family one in 2 of 3.
     scn = tmp_path / "scn.toml"
-    scn.write_text('algorithms = ["rotvec:N=2", "rk4", "rate-three", "rotvec:N=3"]\n'
+    scn.write_text('algorithms = ["rotvec:N=2", "rotvec:N=3"]\n'
                    '[sensor]\nsample_rate_hz = 600.0\nduration = 0.5\n'
                    '[grid]\ncone_rate_hz = [1.0, 2.0]\n')
     res = _strapdown(["sweep", str(scn), "--out", str(tmp_path / "out"), "--workers", "2",
