@@ -52,6 +52,9 @@ BROAD = _broad_dir()
 
 
 _SHARED_FIXTURE = re.compile(r"""@pytest\.fixture\([^)]*scope\s*=\s*["'](?:module|class|package)""")
+#: A module that shares no fixture but an in-process cache its tests fill (a line
+#: ``ONE_WORKER = True`` with a comment saying which): on one worker it is filled once.
+_ONE_WORKER = re.compile(r"^ONE_WORKER\s*=\s*True\b", re.M)
 
 
 @pytest.hookimpl(optionalhook=True)  # a hook of pytest-xdist, absent without it
@@ -59,7 +62,9 @@ def pytest_xdist_make_scheduler(config, log):
     """``make test`` runs the suite in parallel (``pytest -n auto``): each test is a unit of
     work of its own, except that the tests of a module that builds a module-scoped fixture
     (a built site, a corpus of files, a documented session whose commands run in order) are
-    one unit, so one worker builds it once, rather than every worker that gets one of them.
+    one unit, so one worker builds it once, rather than every worker that gets one of them;
+    so are the tests of a module that says ``ONE_WORKER = True`` (they fill a cache of the
+    process, e.g. tests/apps/test_advise.py).
     Big units are handed out first. (``--dist loadgroup`` with ``xdist_group`` marks would
     say the same, but pytest 9.2 ignores the node-id suffix pytest-xdist 3.8 groups by.)"""
     if config.getvalue("dist") != "load":
@@ -77,7 +82,8 @@ def pytest_xdist_make_scheduler(config, log):
                     text = (root / module).read_text(encoding="utf-8")
                 except OSError:
                     text = ""
-                shared[module] = _SHARED_FIXTURE.search(text) is not None
+                shared[module] = (_SHARED_FIXTURE.search(text) is not None
+                                  or _ONE_WORKER.search(text) is not None)
             return module if shared[module] else nodeid
 
     return ModuleFixtureScheduling(config, log)

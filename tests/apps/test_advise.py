@@ -20,6 +20,11 @@ from strapdown.truth.motions import PureSpin, SpinConing
 from strapdown.truth.vibration import random_tone_vibration
 
 FS = 400.0
+#: The advice's K(ω) is mpmath, seconds for a log's Welch bins (strapdown.analysis.spectrum
+#: caches it in the process, 4096 entries: one sampling rate's bins at a time). Its tests
+#: share one worker (tests/conftest.py), and those at FS come before the 1 kHz ones, so the
+#: bins of each rate are computed once.
+ONE_WORKER = True
 
 
 def _log(path, coning: bool, n=4000):
@@ -122,6 +127,23 @@ def test_cli_without_coning_recommends_the_cheapest(tmp_path, capsys):
     out = capsys.readouterr().out
     assert "no coning content" in out
     assert "recommended   rotvec:N=6 (no coning content" in out
+
+
+def test_a_short_incoherent_log_is_undecided_without_verification(tmp_path, capsys):
+    noise = np.random.default_rng(5).normal(size=(600, 3)) * 1e-4
+    log = _write(tmp_path / "noise.csv", noise, 1 / FS)
+    assert main(["advise", "--imu", str(log), "--increments", "--figure",
+                 str(tmp_path / "n.png"), "--no-verify"]) == 0
+    out = capsys.readouterr().out
+    assert "too short to decide" in out and "3 Welch segments" in out
+
+
+def test_cli_takes_the_kind_from_the_header_unit(tmp_path, capsys):
+    """A log whose header says gx[rad] holds increments: no --increments needed."""
+    log = _log(tmp_path / "l.csv", True, n=2000)
+    assert main(["advise", "--imu", str(log), "--json", "--no-verify"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert all(c["spec"].startswith(("rotvec", "Protvec")) for c in out["candidates"])
 
 
 @pytest.mark.parametrize(("args", "msg"), [
@@ -228,15 +250,6 @@ def test_spin_plus_coning_is_not_called_coning_free(tmp_path, capsys, verify):
     assert rec["coning"] == ("detected" if verify == "8" else "undecided"), rec["coning_note"]
 
 
-def test_a_short_incoherent_log_is_undecided_without_verification(tmp_path, capsys):
-    noise = np.random.default_rng(5).normal(size=(600, 3)) * 1e-4
-    log = _write(tmp_path / "noise.csv", noise, 1 / FS)
-    assert main(["advise", "--imu", str(log), "--increments", "--figure",
-                 str(tmp_path / "n.png"), "--no-verify"]) == 0
-    out = capsys.readouterr().out
-    assert "too short to decide" in out and "3 Welch segments" in out
-
-
 def test_verified_drift_of_rate_algorithms_on_a_rate_log():
     """Point samples of the rates (the same aperiodic vibration): the reference corrects for
     point sampling instead of the increment response; five rate algorithms (0.011 to 2.9
@@ -266,11 +279,3 @@ def test_cli_rejects_a_negative_verify(tmp_path, capsys):
               str(tmp_path / "x.png")])
     assert exc.value.code == 2
     assert "--verify must be ≥ 0" in capsys.readouterr().err
-
-
-def test_cli_takes_the_kind_from_the_header_unit(tmp_path, capsys):
-    """A log whose header says gx[rad] holds increments: no --increments needed."""
-    log = _log(tmp_path / "l.csv", True, n=2000)
-    assert main(["advise", "--imu", str(log), "--json", "--no-verify"]) == 0
-    out = json.loads(capsys.readouterr().out)
-    assert all(c["spec"].startswith(("rotvec", "Protvec")) for c in out["candidates"])
