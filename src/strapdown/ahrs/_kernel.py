@@ -893,8 +893,8 @@ def _fold_delay_samples(last, k, n_seen, x, mag, h, is_rate, bias, alpha, res):
 def _delay_choice(cur, res, n_seen, alpha, z):
     """Stage 6, the delay estimator's decision: the candidate of least residual (``res``,
     :func:`_fold_delay_samples`) replaces the delay in use ``cur`` only when its advantage
-    is significant (``z`` standard deviations, ``mag_delay_z``). Between a true delay and a wrong one
-    the mean residuals differ by E, the mean square of ``h (ω_{j−d} − ω_{j−c}) × m``; the
+    is significant (``z`` standard deviations, ``mag_delay_z``). Between a true delay and a
+    wrong one the mean residuals differ by E, the mean square of ``h (ω_{j−d} − ω_{j−c}) × m``; the
     difference of the averages has the standard deviation ``2 σ √(E/N)`` (σ² the noise per
     axis, ``res_min/3``; N the samples averaged, ``min(n_seen, 2/alpha)``). So the switch
     needs ``res[cur] − res_min > (4/3) z² res_min / N``. A steady spin, whose rate barely
