@@ -163,14 +163,20 @@ def _cleanup() -> None:
 
 
 # ---------------------------------------------------------------- the API reference
+#: Deprecated aliases of moved modules: not documented (their docstrings say where to go).
+DEPRECATED_ALIASES = frozenset({"strapdown.algorithms.navigation"})
+
+
 def public_modules() -> list[str]:
-    """Every public module of the package but the command-line modules, sorted."""
+    """Every public module of the package but the command-line modules and the deprecated
+    aliases, sorted."""
     import strapdown
 
     names = ["strapdown"]
     for info in pkgutil.walk_packages(strapdown.__path__, "strapdown."):
         parts = info.name.split(".")
-        if any(p.startswith("_") for p in parts[1:]) or parts[1] == "cli":
+        if (any(p.startswith("_") for p in parts[1:]) or parts[1] == "cli"
+                or info.name in DEPRECATED_ALIASES):
             continue
         names.append(info.name)
     return sorted(names)

@@ -481,11 +481,26 @@ def rate_velocity_algorithms() -> tuple[str, ...]:
                  and fam.velocity(AlgorithmSpec(name)) is not None)
 
 
+#: The inertial integrators that moved to :mod:`strapdown.navigation.inertial` (issue 26),
+#: still reachable here with a ``DeprecationWarning`` for one release.
+_MOVED_TO_NAVIGATION = ("InertialSolution", "MpInertialSolution", "integrate_inertial",
+                        "integrate_inertial_mp", "integrate_inertial_rates")
+
+
 def __getattr__(name: str) -> object:
     # RATE_VELOCITY_ALGORITHMS and NAV_STRUCTURES are read from the registries when asked,
     # so a family or structure registered after this module's import is in them
     if name == "RATE_VELOCITY_ALGORITHMS":
         return rate_velocity_algorithms()
+    if name in _MOVED_TO_NAVIGATION:  # deprecated aliases, for one release (issue 26)
+        import warnings
+
+        from strapdown.navigation import inertial
+
+        warnings.warn(f"strapdown.algorithms.velocity.{name} moved to "
+                      f"strapdown.navigation.{name} (issue 26); this alias goes with the "
+                      "next release", DeprecationWarning, stacklevel=2)
+        return getattr(inertial, name)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
