@@ -535,6 +535,14 @@ def _window_step(e, x, h, prop, offsets, weights, pi, pj, pc, ring, q, bias, phi
 
 
 @njit(cache=True, inline="always", error_model="numpy")
+def _rate_at(k, x, h, is_rate, a):
+    """The gyro's rate of sample k about axis a, rad/s, bias not removed: ``x[k]`` for
+    rate samples (the last row past the record's end), the increment that ends at sample
+    k over ``h`` for increments."""
+    return x[min(k, x.shape[0] - 1), a] if is_rate else x[k - 1, a] / h
+
+
+@njit(cache=True, inline="always", error_model="numpy")
 def _fold_rest_samples(last, k, ema_n, rest_alpha, x, acc, h, is_rate, gm, g2, am, a2):
     """Stage 2: fold samples last + 1 … k into the rest detector's exponential moving
     averages of gyro and accelerometer (and of their squares); returns (last, ema_n)."""
@@ -543,7 +551,7 @@ def _fold_rest_samples(last, k, ema_n, rest_alpha, x, acc, h, is_rate, gm, g2, a
         ema_n += 1.0
         al = max(rest_alpha, 1.0 / ema_n)
         for a in range(3):
-            wv = x[min(last, x.shape[0] - 1), a] if is_rate else x[last - 1, a] / h
+            wv = _rate_at(last, x, h, is_rate, a)
             gm[a] += al * (wv - gm[a])
             g2[a] += al * (wv * wv - g2[a])
             am[a] += al * (acc[last, a] - am[a])
@@ -677,12 +685,10 @@ def _rest_still(k, x, acc, h, is_rate, params, gm, am):
     starts slowly (a spin-up) keeps their variance low for a while and moves their mean
     with it, so without this test the rest update learns the first degrees per second of
     the motion as gyro bias, which no later measurement can undo."""
-    kk = min(k, x.shape[0] - 1) if is_rate else k - 1
     dg = 0.0
     da = 0.0
     for a in range(3):
-        wv = x[kk, a] if is_rate else x[kk, a] / h
-        dg += (wv - gm[a]) ** 2
+        dg += (_rate_at(k, x, h, is_rate, a) - gm[a]) ** 2
         da += (acc[k, a] - am[a]) ** 2
     return dg < params.rest_gyro ** 2 and da < params.rest_acc ** 2
 
@@ -820,7 +826,7 @@ def _lever_sigma(k, x, h, is_rate, bias, lever_arm):
     w2 = 0.0
     wd2 = 0.0
     for a in range(3):
-        wa = x[kk, a] - bias[a] if is_rate else x[kk, a] / h - bias[a]
+        wa = _rate_at(k, x, h, is_rate, a) - bias[a]
         w2 += wa * wa
         dw = x[kk, a] - x[max(kk - 1, 0), a]
         wd2 += (dw / h if is_rate else dw / (h * h)) ** 2

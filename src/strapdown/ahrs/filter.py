@@ -61,7 +61,7 @@ from __future__ import annotations
 
 import math
 import typing
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
 
@@ -669,14 +669,14 @@ def _derived(cfg: AhrsConfig, ref, use_mag: bool, h: float, te: float,
     estimator, in samples."""
     lp = butterworth(cfg.acc_lowpass_s, te)
     mc = butterworth(cfg.mag_current_s, te)
+    lp_init_n = max(1, math.ceil(cfg.acc_lowpass_s / te - 1e-9))
     return {"ref_norm": ref[0], "ref_dip": ref[1], "ref_heading": ref[2],
             "use_magnetometer": use_mag, "soft_gate": cfg.acc_gate_mode == "soft",
             "acc_lowpass": cfg.acc_model == "lowpass",
             **dict(zip(("lp_b0", "lp_b1", "lp_b2", "lp_a1", "lp_a2"), lp, strict=True)),
             **dict(zip(("mc_b0", "mc_b1", "mc_b2", "mc_a1", "mc_a2"), mc, strict=True)),
-            "lp_init_n": max(1, math.ceil(cfg.acc_lowpass_s / te - 1e-9)),
-            "lp_settle": (0 if cfg.acc_lowpass_settle
-                          else -max(1, math.ceil(cfg.acc_lowpass_s / te - 1e-9))),
+            "lp_init_n": lp_init_n,
+            "lp_settle": 0 if cfg.acc_lowpass_settle else -lp_init_n,
             "mc_init_n": max(1, math.ceil(cfg.mag_current_s / te - 1e-9)),
             "dyn_k": 1.0 - math.exp(-te / cfg.acc_lowpass_s),
             "dyn_k2": 1.0 - math.exp(-te / (K.MOTION_SLOW * cfg.acc_lowpass_s)),
@@ -896,8 +896,6 @@ def _backward(rec, acc, mag, have_mag: bool, cfg: AhrsConfig, algorithm: str, fw
     magnetometer, which leads in reversed time, advanced by the forward pass's median
     delay; its rejection budget is ``offline_mag_reject_s``. Returns its completed
     outputs in forward sample order."""
-    from dataclasses import replace
-
     n = rec.t.size
     d = int(np.median(fwd.mag_delay)) if have_mag else 0
     mag_b = np.concatenate([mag[d:], np.repeat(mag[-1:], d, axis=0)])[::-1] if d else mag[::-1]
@@ -974,8 +972,6 @@ def offline_ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
     ValueError
         On invalid input, naming the problem.
     """
-    from dataclasses import replace
-
     cfg = config or AhrsConfig()
     rec, acc, mag, have_mag, q_init, b0, ref = _setup(t, gyro, acc, mag, cfg, q0, gyro_bias0,
                                                        mag_reference, frame)
