@@ -124,16 +124,14 @@ def _fold(args):
 
 
 def _vqf(trials) -> tuple[np.ndarray, np.ndarray]:
-    import vqf
-
     from strapdown.analysis.broad import broad_errors
+    from strapdown.apps.ahrs_benchmark import vqf_attitude
 
     out = []
     for tr in trials:
-        g, a, m = (np.ascontiguousarray(x) for x in (tr.gyro, tr.acc, tr.mag))
         row = []
-        for q in (vqf.VQF(tr.h).updateBatch(g, a, m)["quat9D"],
-                  vqf.offlineVQF(g, a, m, tr.h, {})["quat9D"]):
+        for q in (vqf_attitude(tr.gyro, tr.acc, tr.mag, tr.h, offline=off)
+                  for off in (False, True)):
             e = broad_errors(q, tr.q_ref, tr.movement)
             row.append((e["total_deg"], e["heading_deg"], e["inclination_deg"]))
         out.append(row)

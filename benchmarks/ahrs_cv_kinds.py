@@ -91,16 +91,11 @@ class Data:
 
 
 def _vqf(tr, six_axis: bool) -> tuple[float, float]:
-    import vqf
+    from strapdown.apps.ahrs_benchmark import vqf_attitude
 
-    g, a, m = (np.ascontiguousarray(x) for x in (tr.gyro, tr.acc, tr.mag))
-    if six_axis:
-        qs = (vqf.VQF(tr.h).updateBatch(g, a)["quat6D"],
-              vqf.offlineVQF(g, a, None, tr.h, {})["quat6D"])
-    else:
-        qs = (vqf.VQF(tr.h).updateBatch(g, a, m)["quat9D"],
-              vqf.offlineVQF(g, a, m, tr.h, {})["quat9D"])
-    return tuple(total(q, tr, six_axis) for q in qs)
+    m = None if six_axis else tr.mag
+    return tuple(total(vqf_attitude(tr.gyro, tr.acc, m, tr.h, offline=off), tr, six_axis)
+                 for off in (False, True))
 
 
 def total(q, tr, six_axis: bool) -> float:

@@ -23,21 +23,18 @@ import numpy as np
 
 from strapdown.ahrs.filter import ekf, offline_ekf
 from strapdown.analysis.broad import broad_errors
+from strapdown.apps.ahrs_benchmark import vqf_attitude
 from strapdown.truth.scenarios import record, suite
 
 SETTLE_S = 5.0
 
 
 def _run(t, gyro, acc, mag, q_true, six_axis: bool) -> dict[str, float]:
-    import vqf
-
     h = float(t[1] - t[0])
     moving = t >= SETTLE_S
     m = None if six_axis else mag
-    key = "quat6D" if six_axis else "quat9D"
-    rt = vqf.VQF(h).updateBatch(gyro, acc) if six_axis else vqf.VQF(h).updateBatch(gyro, acc, m)
-    est = {"VQF": np.asarray(rt[key]),
-           "offlineVQF": np.asarray(vqf.offlineVQF(gyro, acc, m, h, {})[key]),
+    est = {"VQF": vqf_attitude(gyro, acc, m, h),
+           "offlineVQF": vqf_attitude(gyro, acc, m, h, offline=True),
            "ours": ekf(t, gyro, acc, m).q,
            "ours offline": offline_ekf(t, gyro, acc, m).q}
     return {k: broad_errors(q, q_true, moving)["total_deg"] for k, q in est.items()}

@@ -40,7 +40,7 @@ from pathlib import Path
 from typing import Any, Literal, get_args
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from strapdown.ahrs import AhrsConfig, ekf, offline_ekf
 from strapdown.analysis.broad import broad_errors
@@ -70,20 +70,29 @@ _OURS: dict[FilterName, dict[str, Any]] = {
 _PEER_MODULE = {"VQF": "vqf", "offlineVQF": "vqf", "Fusion": "imufusion"}
 
 
-def _imu(tr: BroadTrial) -> tuple[NDArray[np.float64], ...]:
-    return tuple(np.ascontiguousarray(a) for a in (tr.gyro, tr.acc, tr.mag))
+def vqf_attitude(gyro: ArrayLike, acc: ArrayLike, mag: ArrayLike | None, h: float, *,
+                 offline: bool = False) -> NDArray[np.float64]:
+    """VQF's estimate with its defaults, q_ENU_b at every sample: ``VQF(h).updateBatch``
+    (``offline=False``) or ``offlineVQF``; 9D with a magnetometer, 6D with ``mag=None``.
+    The one place the benchmarks call VQF (BROAD, the generalisation suite, OpenAXES, the
+    tuning studies)."""
+    import vqf
+
+    g, a = np.ascontiguousarray(gyro, float), np.ascontiguousarray(acc, float)
+    m = None if mag is None else np.ascontiguousarray(mag, float)
+    if offline:
+        out = vqf.offlineVQF(g, a, m, h, {})
+    else:
+        out = vqf.VQF(h).updateBatch(g, a) if m is None else vqf.VQF(h).updateBatch(g, a, m)
+    return np.asarray(out["quat6D" if m is None else "quat9D"])
 
 
 def _vqf(tr: BroadTrial) -> NDArray[np.float64]:
-    import vqf
-
-    return np.asarray(vqf.VQF(tr.h).updateBatch(*_imu(tr))["quat9D"])
+    return vqf_attitude(tr.gyro, tr.acc, tr.mag, tr.h)
 
 
 def _offline_vqf(tr: BroadTrial) -> NDArray[np.float64]:
-    import vqf
-
-    return np.asarray(vqf.offlineVQF(*_imu(tr), tr.h, {})["quat9D"])
+    return vqf_attitude(tr.gyro, tr.acc, tr.mag, tr.h, offline=True)
 
 
 def _fusion(tr: BroadTrial) -> NDArray[np.float64]:

@@ -38,7 +38,7 @@ from numpy.typing import NDArray
 
 from strapdown.ahrs import ekf, offline_ekf
 from strapdown.analysis.alignment import aligned_errors
-from strapdown.apps.ahrs_benchmark import KIND, FilterName, _available
+from strapdown.apps.ahrs_benchmark import KIND, FilterName, _available, vqf_attitude
 from strapdown.io.openaxes import (
     SUSPECT,
     OpenAxesRecording,
@@ -67,12 +67,8 @@ def run_filter(name: FilterName, rec: OpenAxesRecording) -> NDArray[np.float64]:
         return ekf(rec.t, rec.gyro, rec.acc).q
     if name == "strapdown EKF offline":
         return offline_ekf(rec.t, rec.gyro, rec.acc).q
-    import vqf
-
-    if name == "VQF":
-        return np.asarray(vqf.VQF(rec.h).updateBatch(rec.gyro, rec.acc)["quat6D"])
-    if name == "offlineVQF":
-        return np.asarray(vqf.offlineVQF(rec.gyro, rec.acc, None, rec.h, {})["quat6D"])
+    if name in ("VQF", "offlineVQF"):
+        return vqf_attitude(rec.gyro, rec.acc, None, rec.h, offline=name == "offlineVQF")
     raise ValueError(f"unknown filter {name!r}; choose one of {', '.join(FILTERS)}")
 
 
