@@ -23,7 +23,7 @@ import signal
 import sys
 import textwrap
 
-from strapdown._core.signals import replaced_handlers
+from strapdown._core.signals import interrupts_kept, replaced_handlers
 from strapdown.cli import (
     advise,
     ahrs,
@@ -130,7 +130,8 @@ def main(argv: list[str] | None = None) -> int:
     except ValueError:  # not the main thread: signals stay as they are
         previous = None
     try:
-        return _main(argv, got)
+        with interrupts_kept():  # Ctrl-C landing in a finaliser: delivered again, no traceback
+            return _main(argv, got)
     finally:
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)
