@@ -28,6 +28,7 @@ from strapdown.ahrs.filter import (
     _algorithm,
     _params,
     _propagation,
+    _Start,
     butterworth,
     ekf,
 )
@@ -56,7 +57,8 @@ def k(monkeypatch):
 
 def _params_of(h=0.01, te=None, g_measured=G, **cfg):
     """The kernel's parameter record for ``AhrsConfig(**cfg)``, sample period h, epoch te."""
-    return _params(AhrsConfig(**cfg), REF, True, h, h if te is None else te, g_measured)
+    return _params(AhrsConfig(**cfg), REF, True, h, h if te is None else te,
+                   _Start(True, g_measured, True, 0.05))
 
 
 def _skew(v):
@@ -302,7 +304,7 @@ def test_rest_detection_thresholds(k):
         av = np.full(3, f_av * 0.28**2 / 3)
         up = np.array([0.36, -0.48, 0.8])  # any direction
         stats = _rest_stats(f_gm * 0.035 * up, gv, (G + d_an * 0.28) * up, av)
-        return k._rest_detect(ema_n, alpha, p, *stats)
+        return k._rest_detect(ema_n, alpha, p, *stats, p.gravity_measured)
 
     assert detect() == (True, True)
     assert detect(f_gv=0.98) == (True, True) and detect(f_gv=1.02) == (True, False)
@@ -329,7 +331,7 @@ def test_rest_detection_on_a_synthetic_signal(k):
         w = np.array([0.01, -0.02, 0.005]) + a * sign * np.array([1.0, 0.0, 0.0])
         gm, g2, am, a2 = (np.zeros(3) for _ in range(4))
         _, ema_n = k._fold_rest_samples(0, n - 1, 0.0, alpha, w, acc, h, True, gm, g2, am, a2)
-        assert k._rest_detect(ema_n, alpha, p, gm, g2, am, a2) == (True, rest)
+        assert k._rest_detect(ema_n, alpha, p, gm, g2, am, a2, p.gravity_measured) == (True, rest)
 
 
 def test_zero_rate_update_is_the_kalman_filter_of_a_constant(k):
@@ -463,7 +465,7 @@ def test_lowpass_plausibility_is_relative_to_measured_gravity(k):
     p = _params_of(acc_lowpass_norm_tol=0.015, g_measured=gm)
     up = np.array([0.6, 0.0, 0.8])
     for f, ok in ((0.99, True), (1.01, False), (-0.99, True), (-1.01, False)):
-        assert bool(k._lowpass_plausible(gm * (1 + f * 0.015) * up, p)) is ok
+        assert bool(k._lowpass_plausible(gm * (1 + f * 0.015) * up, p, gm)) is ok
 
 
 # ------------------------------------------------------------------ 5b. raw accelerometer

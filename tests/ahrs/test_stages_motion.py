@@ -16,7 +16,7 @@ from scipy.linalg import expm
 from scipy.signal import lfilter
 
 import strapdown.ahrs._kernel as K
-from strapdown.ahrs.filter import AhrsConfig, _params
+from strapdown.ahrs.filter import AhrsConfig, _params, _Start
 from strapdown.rotation.dcm import dcm_from_quat
 from strapdown.rotation.quaternion import quat_from_rotvec
 
@@ -36,7 +36,8 @@ def k(monkeypatch):
 
 
 def _params_of(h=0.01, te=None, **cfg):
-    return _params(AhrsConfig(**cfg), REF, True, h, h if te is None else te, G)
+    return _params(AhrsConfig(**cfg), REF, True, h, h if te is None else te,
+                   _Start(True, G, True, 0.05))
 
 
 def _skew(v):
@@ -145,9 +146,9 @@ def test_rest_compares_the_accelerometer_with_gravity_as_measured(k):
     """Quiet needs the mean specific force within rest_acc of the norm measured over the
     initial window (the accelerometer's scale error included), not of the nominal g."""
     g_m = 9.5  # a 3 % scale error: |g_m − g| > rest_acc
-    p = _params(AhrsConfig(rest_acc=0.28), REF, True, 0.01, 0.01, g_m)
+    p = _params(AhrsConfig(rest_acc=0.28), REF, True, 0.01, 0.01, _Start(True, g_m, True, 0.05))
     up = np.array([0.0, 0.6, 0.8])
     zero = np.zeros(3)
     for f, quiet in ((0.0, True), (0.98, True), (-0.98, True), (1.02, False), (-1.02, False)):
         am = (g_m + f * 0.28) * up
-        assert bool(k._rest_detect(100.0, 0.02, p, zero, zero, am, am**2)[0]) is quiet, f
+        assert bool(k._rest_detect(100.0, 0.02, p, zero, zero, am, am**2, g_m)[0]) is quiet, f

@@ -170,7 +170,11 @@ class Params(NamedTuple):
     acc_lowpass_s: float
     acc_motion_leak: float
     acc_lowpass_norm_tol: float
-    gravity_measured: float  #: the specific force's norm over the initial window
+    gravity_measured: float  #: gravity's norm as this accelerometer measures it: over the
+    #: initial window when it is still, else the nominal ``gravity`` until the first rest
+    gravity_known: bool  #: gravity_measured was measured (a still start), not assumed
+    mag_provisional_s: float  #: a moving start: the field's reference norm and dip follow
+    #: the measurement this long (the start's tilt, and so its dip, is not yet known)
     acc_gate_lowpass: float
     acc_bias_rw: float
     mag_new_s: float
@@ -653,14 +657,14 @@ def _add_process_noise(P, C, phi, T, qg, qb, qa, qab, params, singer, unobserved
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _rest_detect(ema_n, rest_alpha, params, gm, g2, am, a2):
+def _rest_detect(ema_n, rest_alpha, params, gm, g2, am, a2, g_meas):
     """Stage 4, detection from the moving averages; returns (acc_quiet, at_rest).
 
     Quiet accelerometer: low variance and a mean of gravity's magnitude as this
-    accelerometer measures it (``gravity_measured``, over the initial window: an
-    uncalibrated scale factor of a few per cent — OpenAXES's sensors read 9.44 m/s² at
-    rest — is not a sustained manoeuvre); at rest: also a gyro of low variance and small
-    mean.
+    accelerometer measures it (``g_meas``: over a still initial window; after a start in
+    motion the nominal one until the first rest measures it; an uncalibrated scale factor
+    of a few per cent — OpenAXES's sensors read 9.44 m/s² at rest — is not a sustained
+    manoeuvre); at rest: also a gyro of low variance and small mean.
     """
     sg = 0.0
     sacc = 0.0
@@ -671,7 +675,7 @@ def _rest_detect(ema_n, rest_alpha, params, gm, g2, am, a2):
     settled = ema_n * rest_alpha > 1.0
     ra = params.rest_acc
     a_norm = np.sqrt(am[0] ** 2 + am[1] ** 2 + am[2] ** 2)
-    acc_quiet = settled and sacc < ra * ra and abs(a_norm - params.gravity_measured) < ra
+    acc_quiet = settled and sacc < ra * ra and abs(a_norm - g_meas) < ra
     rg = params.rest_gyro
     at_rest = acc_quiet and sg < rg * rg and wm2 < params.rest_gyro_mean ** 2
     return acc_quiet, at_rest
@@ -799,13 +803,14 @@ def _lowpass_variance(params, dyn2, T):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _lowpass_plausible(lp, params):
-    """Low-pass model: the low-passed specific force has gravity's norm (the one measured
-    over the initial window) within ``acc_lowpass_norm_tol``; a sustained acceleration
-    — a coordinated turn's centripetal one, which no low-pass removes — makes it longer
-    (by 1.5 % at 10° of bank, 6.4 % at 20°)."""
+def _lowpass_plausible(lp, params, g_meas):
+    """Low-pass model: the low-passed specific force has gravity's norm as this
+    accelerometer measures it (``g_meas``: over a still initial window or at the first
+    rest; the nominal one before that) within ``acc_lowpass_norm_tol``; a sustained
+    acceleration — a coordinated turn's centripetal one, which no low-pass removes —
+    makes it longer (by 1.5 % at 10° of bank, 6.4 % at 20°)."""
     n = np.sqrt(lp[0] ** 2 + lp[1] ** 2 + lp[2] ** 2)
-    return abs(n - params.gravity_measured) <= params.acc_lowpass_norm_tol * params.gravity_measured
+    return abs(n - g_meas) <= params.acc_lowpass_norm_tol * g_meas
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -997,6 +1002,21 @@ def _mag_disturbance(T, rate2, params, nd, ms):
     if ms[M_DIST] == 0.0:
         ms[M_REJECT] = max(ms[M_REJECT] - params.mag_disturbed_factor * T, 0.0)
     return ms[M_DIST] > 0.0
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _mag_provisional(params, nd, ms):
+    """Stage 6, after a moving start: the reference norm and dip (and the candidate's) set
+    to the low-passed measurement, undisturbed. The dip is measured with the estimated
+    tilt, which a start in motion gets wrong by up to tens of degrees until the
+    accelerometer has corrected it; a reference learned from it would call the true field
+    disturbed for ``mag_new_s`` and keep the heading from converging."""
+    ms[M_NORM] = nd[0]
+    ms[M_DIP] = nd[1]
+    ms[M_CNORM] = nd[0]
+    ms[M_CDIP] = nd[1]
+    ms[M_UNDIST] = params.mag_settle_s
+    ms[M_DIST] = 0.0
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -1219,6 +1239,8 @@ def ekf_kernel(sensors, prop, window, params, init, out):
     acc_bad_since = -1.0  # start of the current run of rejections (−1: none)
     mag_bad_since = -1.0
     heading_unobserved = False  # the last epoch rejected a disturbed field (heading_bridge_noise)
+    g_meas = params.gravity_measured  # gravity's norm as measured (or assumed, g_known false)
+    g_known = params.gravity_known
     mag_dist_prev = False  # the last epoch found the field disturbed
     e = 0
     # start-up outputs of the sliding scheme (samples 1 … lag−1 by single-period steps)
@@ -1251,9 +1273,13 @@ def ekf_kernel(sensors, prop, window, params, init, out):
         dx[:] = 0.0
         tk = k * h
         # stage 4: rest
-        acc_quiet, at_rest = _rest_detect(ema_n, rest_alpha, params, gm, g2, am, a2)
+        acc_quiet, at_rest = _rest_detect(ema_n, rest_alpha, params, gm, g2, am, a2, g_meas)
         at_rest = at_rest and _rest_still(k, x, acc, h, is_rate, params, gm, am)
         rest_since = (rest_since if rest_since >= 0.0 else tk) if at_rest else -1.0
+        if not g_known and at_rest and tk - rest_since >= params.rest_min_s:
+            # a moving start's gravity, measured at its first rest
+            g_meas = np.sqrt(am[0] ** 2 + am[1] ** 2 + am[2] ** 2)
+            g_known = True
         if params.rest_update and at_rest and tk - rest_since >= params.rest_min_s:
             _rest_model(params, bias, gm, dx, y3)
             _gated_update(P, H_rest, 6, params.rest_noise ** 2 / T, y3, 0.0, False, True, False,
@@ -1274,7 +1300,7 @@ def ekf_kernel(sensors, prop, window, params, init, out):
                 dyn2 = _motion_power(dyn2, lp_n, params, lp, lp2)
                 # a sustained acceleration (a coordinated turn) does not average out: the
                 # low-passed specific force is then longer than gravity
-                disturbed = params.gating and not _lowpass_plausible(lp, params)
+                disturbed = params.gating and not _lowpass_plausible(lp, params, g_meas)
                 ok = False
                 # lp_settle = 0: no update while the low-pass is still averaging its first
                 # lp_init_n epochs unless the accelerometer is quiet (a running mean of a
@@ -1319,14 +1345,19 @@ def ekf_kernel(sensors, prop, window, params, init, out):
             nd_raw[1] = -np.arcsin(min(max(mn[2] / nb, -1.0), 1.0)) if nb > 0.0 else 0.0
             mc_n = _lowpass(nd_raw, mc_n, params.mc_init_n, params.mc_b0, params.mc_b1,
                             params.mc_b2, params.mc_a1, params.mc_a2, mc_s0, mc_s1, nd)
+            provisional = tk < params.mag_provisional_s
+            if provisional:
+                _mag_provisional(params, nd, ms)
             dist = params.gating and _mag_disturbance(T, gm[0] ** 2 + gm[1] ** 2 + gm[2] ** 2,
                                                       params, nd, ms)
             horizontal = mn[0] ** 2 + mn[1] ** 2 > 1e-12 * nb * nb
             if dist:
                 flags |= F_MAG_DISTURBED
             if horizontal and not (dist and ms[M_REJECT] <= params.mag_reject_s):
-                force = _recovery_due(params.gating, not dist, mag_bad_since, tk,
-                                      params.recover_mag_s)
+                # after a start in motion the heading follows the field (recovered every
+                # epoch) while the tilt, and with it the measured heading, converges
+                force = provisional or _recovery_due(params.gating, not dist, mag_bad_since, tk,
+                                                     params.recover_mag_s)
                 if force:
                     flags |= _mag_recovery(params, P, C)
                 _heading_model(params, C, mn, dx, H_mag, y1)
@@ -1372,7 +1403,7 @@ def ekf_kernel(sensors, prop, window, params, init, out):
         out_flags[k] = flags
         out_nis[k, 0] = nis_acc
         out_nis[k, 1] = nis_mag
-    return total
+    return total, g_meas, g_known
 
 
 @njit(cache=True, error_model="numpy")

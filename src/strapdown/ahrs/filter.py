@@ -38,9 +38,14 @@ with the accelerometer and magnetometer handling of Laidig & Seel (2023)):
   the filter, not the sensor, must be wrong: it inflates the affected covariance
   and accepts again;
 - **initial attitude** from the mean accelerometer and magnetometer over
-  ``init_window_s`` (TRIAD) when none is given (the window is assumed at
-  rest); the reference field (norm, dip, heading) is learned there too,
-  unless given.
+  ``init_window_s`` (TRIAD) when none is given; the reference field (norm, dip,
+  heading) is learned there too, unless given. A window that is not still (the rest
+  detector's statistics, :func:`start_is_still`) is a **start in motion**: its samples
+  are turned into the first sample's body frame by the gyro before they are averaged,
+  the initial attitude uncertainty is ``moving_start_sigma0``, the low-pass
+  accelerometer model waits for its low-pass to settle, the field's reference norm and
+  dip follow the measurement for ``moving_start_mag_s``, and gravity's norm is the
+  nominal one until the first rest measures it.
 
 :func:`ekf` is causal (one pass, no sample after the estimate's own is used);
 :func:`offline_ekf` adds a backward pass and combines the two (Fraser & Potter
@@ -71,7 +76,7 @@ from strapdown.ahrs.flags import MeasurementFlag
 from strapdown.rotation.quaternion import quat_multiply
 
 __all__ = ["AhrsConfig", "AhrsResult", "attitude_from_acc_mag", "butterworth", "ekf",
-           "offline_ekf"]
+           "offline_ekf", "start_is_still"]
 
 G = 9.80665
 #: q_NED_ENU: rotation by π about (1, 1, 0)/√2 (swaps x and y, flips z).
@@ -333,6 +338,18 @@ class AhrsConfig:
         Averaging window for the initial attitude and the reference field, s.
     attitude_sigma0 : float
         Initial attitude uncertainty, rad. Default 0.05.
+    moving_start_sigma0 : float
+        Initial attitude uncertainty when the initial window is not still (a start in
+        motion, :func:`start_is_still`), rad, every axis. The window's mean specific force
+        then holds the motion's mean acceleration, ``Δv/T`` over the window (a swing's
+        metres per second over half a second: tens of degrees of tilt, and through the
+        field's dip more of heading). Default 0.3. With 0.05 every later measurement
+        failed the gates: simulated records cut in motion ended 12–350 times VQF's error.
+    moving_start_mag_s : float
+        After a start in motion, the magnetometer's reference norm and dip follow the
+        measurement for this long, s: the dip is measured with the estimated tilt, wrong
+        at such a start, and a reference learned from it called the true field
+        disturbed and kept the heading from converging. Default 5.
     declination_deg : float
         Magnetic declination (east positive); 0 gives a magnetic-north heading.
     gravity : float
@@ -399,6 +416,8 @@ class AhrsConfig:
     use_magnetometer: bool = True
     init_window_s: float = 0.5
     attitude_sigma0: float = 0.05
+    moving_start_sigma0: float = 0.3
+    moving_start_mag_s: float = 5.0
     declination_deg: float = 0.0
     gravity: float = G
 
@@ -607,16 +626,53 @@ def _init_window(rec, cfg: AhrsConfig) -> int:
     return max(2, min(rec.t.size, round(cfg.init_window_s / rec.td)))
 
 
-def _initial_attitude(rec, acc, mag, have_mag: bool, cfg: AhrsConfig, q0, frame: str):
+def start_is_still(t, gyro, acc, config: AhrsConfig | None = None) -> bool:
+    """Whether a record's initial window (``init_window_s``) is still, as the filter
+    decides it: the rest detector's statistics over the window — the gyro's variance
+    (summed over the axes) below ``rest_gyro²``, its mean's norm below ``rest_gyro_mean``
+    and the accelerometer's variance below ``rest_acc²`` (gravity's norm is not known
+    yet, so it is not tested). Otherwise the filter starts in motion (see the module
+    docstring). Arguments as for :func:`ekf`."""
+    cfg = config or AhrsConfig()
+    rec = _validate(t, gyro, acc, None, cfg, "ENU")[0]
+    return _still(rec, np.ascontiguousarray(acc, dtype=np.float64), cfg)
+
+
+def _still(rec, acc, cfg: AhrsConfig) -> bool:
+    """:func:`start_is_still` on a validated record."""
+    w = _init_window(rec, cfg)
+    g, a = rec.omega[:w], acc[:w]
+    return bool(np.sum(np.var(g, axis=0)) < cfg.rest_gyro ** 2
+                and np.linalg.norm(g.mean(axis=0)) < cfg.rest_gyro_mean
+                and np.sum(np.var(a, axis=0)) < cfg.rest_acc ** 2)
+
+
+def _derotated(rec, x, w: int) -> np.ndarray:
+    """The first ``w`` rows of ``x`` (body-frame vectors) turned into the first sample's
+    body frame along the gyro's attitude (``rate-single``)."""
+    from strapdown.algorithms.rate import rate_attitude
+    from strapdown.rotation.dcm import dcm_from_quat
+
+    q = rate_attitude(rec.t[:w], rec.omega[:w], algorithm="rate-single").q
+    return np.einsum("nij,nj->ni", dcm_from_quat(q), x[:w])
+
+
+def _initial_attitude(rec, acc, mag, have_mag: bool, cfg: AhrsConfig, q0, frame: str,
+                      still: bool):
     """q_ENU_b at the start and the body-frame field there (None without heading).
 
-    Without ``q0`` the initial window is assumed at rest: its mean specific
-    force and field give the attitude by TRIAD (:func:`attitude_from_acc_mag`).
+    Without ``q0``, the initial window's mean specific force and field give the attitude
+    by TRIAD (:func:`attitude_from_acc_mag`); a window that is not still is first turned
+    into its first sample's frame by the gyro (a rotating body's mean would otherwise
+    average over the rotation: a 1.5 Hz spin turns 270° in half a second).
     """
     if q0 is None:
         w = _init_window(rec, cfg)
-        m0 = mag[:w].mean(axis=0) if have_mag else None
-        return attitude_from_acc_mag(acc[:w].mean(axis=0), m0,
+        a = acc[:w] if still else _derotated(rec, acc, w)
+        m0 = None
+        if have_mag:
+            m0 = (mag[:w] if still else _derotated(rec, mag, w)).mean(axis=0)
+        return attitude_from_acc_mag(a.mean(axis=0), m0,
                                      declination_deg=cfg.declination_deg), m0
     q_init = as_quaternions(q0, "q0").reshape(4)
     q_init = q_init / np.linalg.norm(q_init)
@@ -661,7 +717,7 @@ def butterworth(tau: float, ts: float) -> tuple[float, float, float, float, floa
 
 
 def _derived(cfg: AhrsConfig, ref, use_mag: bool, h: float, te: float,
-             g_measured: float) -> dict:
+             start: _Start) -> dict:
     """The kernel parameters that are not config fields of the same name: the reference
     field ``ref`` (norm, dip, heading), the switches, and what depends on the epoch
     period ``te`` — the low-pass coefficients and averaging counts, the reference's
@@ -676,7 +732,7 @@ def _derived(cfg: AhrsConfig, ref, use_mag: bool, h: float, te: float,
             **dict(zip(("lp_b0", "lp_b1", "lp_b2", "lp_a1", "lp_a2"), lp, strict=True)),
             **dict(zip(("mc_b0", "mc_b1", "mc_b2", "mc_a1", "mc_a2"), mc, strict=True)),
             "lp_init_n": lp_init_n,
-            "lp_settle": 0 if cfg.acc_lowpass_settle else -lp_init_n,
+            "lp_settle": 0 if cfg.acc_lowpass_settle or not start.still else -lp_init_n,
             "mc_init_n": max(1, math.ceil(cfg.mag_current_s / te - 1e-9)),
             "dyn_k": 1.0 - math.exp(-te / cfg.acc_lowpass_s),
             "dyn_k2": 1.0 - math.exp(-te / (K.MOTION_SLOW * cfg.acc_lowpass_s)),
@@ -686,18 +742,19 @@ def _derived(cfg: AhrsConfig, ref, use_mag: bool, h: float, te: float,
             "mag_delay_alpha": min(1.0, h / cfg.mag_delay_tau_s), "store_covariance": False,
             "meas_lead": (0.5 * h if cfg.gyro_sample == "interval" and cfg.mag_sample == "point"
                           else 0.0),
-            "gravity_measured": g_measured}
+            "gravity_measured": start.gravity, "gravity_known": start.gravity_known,
+            "mag_provisional_s": start.mag_provisional_s}
 
 
 def _params(cfg: AhrsConfig, ref, use_mag: bool, h: float, te: float,
-            g_measured: float) -> K.Params:
+            start: _Start) -> K.Params:
     """The kernel's parameter record: the config's fields of the same name and
     :func:`_derived`'s for the sample period ``h`` and the epoch period ``te``.
 
     Every value is converted to its field's type (float, int or bool), so the
     compiled kernel's signature — and numba's cache entry — never changes.
     """
-    derived = _derived(cfg, ref, use_mag, h, te, g_measured)
+    derived = _derived(cfg, ref, use_mag, h, te, start)
     types = typing.get_type_hints(K.Params)
     return K.Params(**{f: types[f](derived[f] if f in derived else getattr(cfg, f))
                        for f in K.Params._fields})
@@ -714,13 +771,15 @@ def _propagation(a: dict) -> tuple[K.Propagation, K.Window]:
     return prop, window
 
 
-def _initial_covariance(cfg: AhrsConfig) -> np.ndarray:
-    """P0: attitude, gyro bias (and the raw model's manoeuvre acceleration, the
+def _initial_covariance(cfg: AhrsConfig, attitude_sigma0: float | None = None) -> np.ndarray:
+    """P0: attitude (``attitude_sigma0``, default the config's; :class:`_Start` widens it
+    after a start in motion), gyro bias (and the raw model's manoeuvre acceleration, the
     accelerometer bias)."""
     singer = cfg.acc_model == "raw"
     nx = 6 + 3 * singer + 3 * cfg.estimate_acc_bias
     P0 = np.zeros((nx, nx))
-    P0[:3, :3] = np.eye(3) * cfg.attitude_sigma0**2
+    sigma = cfg.attitude_sigma0 if attitude_sigma0 is None else attitude_sigma0
+    P0[:3, :3] = np.eye(3) * sigma**2
     P0[3:6, 3:6] = np.eye(3) * cfg.gyro_bias_sigma0**2
     if singer:
         P0[6:9, 6:9] = np.eye(3) * cfg.singer_sigma**2
@@ -749,9 +808,9 @@ def _run(rec, acc, mag, prop: K.Propagation, window: K.Window, params: K.Params,
     out.attitude_cov[0] = init.P[:3, :3]
     out.bias_var[0] = np.diag(init.P)[3:6]
     out.mag_delay[0] = params.mag_delay
-    k = K.ekf_kernel(K.Sensors(np.ascontiguousarray(x), acc, mag, float(h)), prop, window,
-                     params, init, out)
-    return out, k
+    k, g, g_known = K.ekf_kernel(K.Sensors(np.ascontiguousarray(x), acc, mag, float(h)), prop,
+                                 window, params, init, out)
+    return out, k, (float(g), bool(g_known))
 
 
 def _fill_between_epochs(rec, q, bias, last):
@@ -809,34 +868,57 @@ def _result(rec, out: K.Outputs, epoch, frame: str, have_mag: bool, algorithm: s
                       out.mag_delay * rec.td if have_mag else None, smoothed)
 
 
-def _gravity_measured(rec, acc, cfg: AhrsConfig) -> float:
-    """The specific force's norm over the initial window (assumed at rest): gravity as
-    this accelerometer measures it, scale error included."""
-    return float(np.linalg.norm(acc[:_init_window(rec, cfg)].mean(axis=0)))
+class _Start(typing.NamedTuple):
+    """How a pass starts: the initial window still (else a start in motion); gravity's
+    norm as this accelerometer measures it — measured (``gravity_known``) or, after a
+    start in motion, the nominal one until a rest measures it; and, after a start in
+    motion whose attitude comes from the window, its wider initial uncertainty and the
+    time the field's reference follows the measurement (0: not at all)."""
+
+    still: bool
+    gravity: float
+    gravity_known: bool
+    attitude_sigma0: float
+    mag_provisional_s: float = 0.0
+
+
+def _start(rec, acc, cfg: AhrsConfig, q0, mag_reference) -> _Start:
+    """The forward pass's :class:`_Start`: a still window's mean specific force's norm is
+    gravity as this accelerometer measures it, scale error included. A start in motion
+    widens the initial uncertainty only when the attitude is the window's (no ``q0``), and
+    makes the reference field provisional only when it is also learned there."""
+    if _still(rec, acc, cfg):
+        return _Start(True, float(np.linalg.norm(acc[:_init_window(rec, cfg)].mean(axis=0))),
+                      True, cfg.attitude_sigma0)
+    if q0 is not None:
+        return _Start(False, float(cfg.gravity), False, cfg.attitude_sigma0)
+    return _Start(False, float(cfg.gravity), False, cfg.moving_start_sigma0,
+                  cfg.moving_start_mag_s if mag_reference is None else 0.0)
 
 
 def _setup(t, gyro, acc, mag, cfg: AhrsConfig, q0, gyro_bias0, mag_reference, frame):
     """Validated record and initial state: (rec, acc, mag, have_mag, q_init (ENU), b0,
-    reference field (norm, dip, heading))."""
+    reference field (norm, dip, heading), :class:`_Start`)."""
     rec, acc, mag, have_mag = _validate(t, gyro, acc, mag, cfg, frame)
-    q_init, m0 = _initial_attitude(rec, acc, mag, have_mag, cfg, q0, frame)
+    start = _start(rec, acc, cfg, q0, mag_reference)
+    q_init, m0 = _initial_attitude(rec, acc, mag, have_mag, cfg, q0, frame, start.still)
     ref = (_reference_field(rec, mag, q_init, m0, q0, mag_reference, cfg) if have_mag
            else (0.0, 0.0, 0.0))
     b0 = np.zeros(3) if gyro_bias0 is None else _check("gyro_bias0", [gyro_bias0], 1)[0]
-    return rec, acc, mag, have_mag, q_init, b0, ref
+    return rec, acc, mag, have_mag, q_init, b0, ref, start
 
 
 def _filter(rec, acc, mag, have_mag: bool, cfg: AhrsConfig, algorithm: str, q_init, b0,
-            ref, g_measured: float, store_covariance: bool = False):
+            ref, start: _Start, store_covariance: bool = False):
     """One causal pass: the completed per-sample outputs (ENU; with the attitude and bias
-    covariances when ``store_covariance``) and the epoch mask. ``g_measured``: gravity's
-    norm as the accelerometer measures it (:func:`_gravity_measured`)."""
+    covariances when ``store_covariance``), the epoch mask, and gravity's norm at the
+    end, with whether a rest measured it (``(g, known)``)."""
     prop, window = _propagation(_algorithm(algorithm))
-    init = K.Initial(q_init, b0, _initial_covariance(cfg))
-    params = _params(cfg, ref, have_mag, rec.td, prop.stride * rec.td, g_measured)._replace(
+    init = K.Initial(q_init, b0, _initial_covariance(cfg, start.attitude_sigma0))
+    params = _params(cfg, ref, have_mag, rec.td, prop.stride * rec.td, start)._replace(
         store_covariance=store_covariance)
-    out, k = _run(rec, acc, mag, prop, window, params, init)
-    return out, _fill(rec, out, k)
+    out, k, gravity = _run(rec, acc, mag, prop, window, params, init)
+    return out, _fill(rec, out, k), gravity
 
 
 def ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
@@ -882,15 +964,14 @@ def ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
         On invalid input, naming the problem.
     """
     cfg = config or AhrsConfig()
-    rec, acc, mag, have_mag, q_init, b0, ref = _setup(t, gyro, acc, mag, cfg, q0, gyro_bias0,
-                                                       mag_reference, frame)
-    out, epoch = _filter(rec, acc, mag, have_mag, cfg, algorithm, q_init, b0, ref,
-                         _gravity_measured(rec, acc, cfg))
+    rec, acc, mag, have_mag, q_init, b0, ref, start = _setup(t, gyro, acc, mag, cfg, q0,
+                                                              gyro_bias0, mag_reference, frame)
+    out, epoch, _ = _filter(rec, acc, mag, have_mag, cfg, algorithm, q_init, b0, ref, start)
     return _result(rec, out, epoch, frame, have_mag, algorithm, cfg)
 
 
 def _backward(rec, acc, mag, have_mag: bool, cfg: AhrsConfig, algorithm: str, fwd, ref,
-              g_measured: float):
+              gravity: tuple[float, bool]):
     """The same filter over the time-reversed record (gyro negated), started from the
     forward pass's last attitude and bias and with its reference field; the
     magnetometer, which leads in reversed time, advanced by the forward pass's median
@@ -915,9 +996,11 @@ def _backward(rec, acc, mag, have_mag: bool, cfg: AhrsConfig, algorithm: str, fw
     cfg_b = replace(cfg, estimate_mag_delay=False, mag_delay_s=0.0, acc_lowpass_settle=True,
                     heading_bridge_noise=True, mag_reject_s=cfg.offline_mag_reject_s,
                     attitude_sigma0=max(sig_att, 1e-4), gyro_bias_sigma0=max(sig_bias, 1e-6))
-    out, epoch = _filter(rec_b, np.ascontiguousarray(acc[::-1]), np.ascontiguousarray(mag_b),
-                         have_mag, cfg_b, algorithm, fwd.q[-1], -fwd.gyro_bias[-1], ref,
-                         g_measured, True)
+    # its start is the forward pass's end: still or not, no window is averaged; gravity is
+    # what the forward pass ended with
+    out, epoch, _ = _filter(rec_b, np.ascontiguousarray(acc[::-1]), np.ascontiguousarray(mag_b),
+                            have_mag, cfg_b, algorithm, fwd.q[-1], -fwd.gyro_bias[-1], ref,
+                            _Start(True, *gravity, cfg_b.attitude_sigma0), True)
     _to_stamps(out, rec_b.omega, rec, cfg)
     rev = np.arange(n)[::-1]
     for f in ("q", "gyro_bias", "accel", "acc_bias", "flags", "nis", "attitude_sigma",
@@ -973,13 +1056,13 @@ def offline_ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
         On invalid input, naming the problem.
     """
     cfg = config or AhrsConfig()
-    rec, acc, mag, have_mag, q_init, b0, ref = _setup(t, gyro, acc, mag, cfg, q0, gyro_bias0,
-                                                       mag_reference, frame)
-    g = _gravity_measured(rec, acc, cfg)
+    rec, acc, mag, have_mag, q_init, b0, ref, start = _setup(t, gyro, acc, mag, cfg, q0,
+                                                              gyro_bias0, mag_reference, frame)
     cfg_pass = replace(cfg, heading_rate_noise=cfg.offline_heading_rate_noise)
-    fwd, epoch = _filter(rec, acc, mag, have_mag, cfg_pass, algorithm, q_init, b0, ref, g, True)
+    fwd, epoch, gravity = _filter(rec, acc, mag, have_mag, cfg_pass, algorithm, q_init, b0,
+                                  ref, start, True)
     _to_stamps(fwd, rec.omega, rec, cfg)
-    bwd, _ = _backward(rec, acc, mag, have_mag, cfg_pass, algorithm, fwd, ref, g)
+    bwd, _ = _backward(rec, acc, mag, have_mag, cfg_pass, algorithm, fwd, ref, gravity)
     _combine(fwd, bwd)
     return _result(rec, fwd, epoch, frame, have_mag, algorithm, cfg, smoothed=True)
 

@@ -39,7 +39,8 @@ __all__ = ["LEARNED", "AhrsExport", "export_ahrs", "generate_ahrs", "propagation
 _TEMPLATES = Path(__file__).parent / "templates"
 #: Params fields the filter learns from the record (state, not constants); the low-pass
 #: coefficients (arrays LP, MC); the delay ring's size (a macro); the offline switch.
-LEARNED = ("ref_norm", "ref_dip", "ref_heading", "use_magnetometer", "gravity_measured")
+LEARNED = ("ref_norm", "ref_dip", "ref_heading", "use_magnetometer", "gravity_measured",
+           "gravity_known", "mag_provisional_s", "lp_settle")
 _NOT_IN_PRM = (*LEARNED, "store_covariance", "mag_delay_max", "rest_tau",
                *(f"{p}_{c}" for p in ("lp", "mc") for c in ("b0", "b1", "b2", "a1", "a2")))
 _MATH = ("sqrt", "sin", "cos", "atan2", "asin", "exp", "pow", "fabs")
@@ -90,7 +91,8 @@ def propagation_supported(algorithm: str) -> dict:
 
 def _params(cfg: AhrsConfig, mag: bool, h: float, stride: int) -> K.Params:
     """The kernel's parameter record for this configuration (learned fields neutral)."""
-    return F._params(cfg, (1.0, 0.0, 0.0), mag, h, stride * h, cfg.gravity)
+    return F._params(cfg, (1.0, 0.0, 0.0), mag, h, stride * h,
+                     F._Start(True, cfg.gravity, True, cfg.attitude_sigma0))
 
 
 def _prm_struct(params: K.Params, rk4: bool, real: str) -> str:
@@ -151,7 +153,12 @@ def _constants(cfg: AhrsConfig, params: K.Params, prop: dict, h: float, mag: boo
               "PI": _lit(math.pi, real), "TINY": _lit(1e-300 if real == "double" else 1e-30,
                                                        real),
               "COS_DECL": _lit(math.cos(d), real), "SIN_DECL": _lit(math.sin(d), real),
-              "NAN": "((NAME_real)NAN)", **_epoch_constants(cfg, params, prop, h, real)}
+              "NAN": "((NAME_real)NAN)",
+              # a start in motion (filter._initial_covariance, filter._derived)
+              "MOVING_SIGMA0_SQ": _lit(cfg.moving_start_sigma0 ** 2, real),
+              "MOVING_MAG_S": _lit(cfg.moving_start_mag_s, real),
+              "SETTLE_ALWAYS": str(int(cfg.acc_lowpass_settle)),
+              **_epoch_constants(cfg, params, prop, h, real)}
     lines = [f"#define PREFIX_{k} {v}" for k, v in macros.items()]
     lit = lambda v: _lit(v, real)  # noqa: E731
     lines += ["", "/* the propagation algorithm's window (filter._algorithm): node offsets, "
@@ -166,7 +173,7 @@ def _constants(cfg: AhrsConfig, params: K.Params, prop: dict, h: float, mag: boo
               *(_table(p.upper(), "NAME_wide", [getattr(params, f"{p}_{c}") for c in
                                                 ("b0", "b1", "b2", "a1", "a2")],
                        lambda v: _lit(v, "double")) for p in ("lp", "mc")),
-              "/* P0 (filter._initial_covariance), diagonal */",
+              "/* P0 (filter._initial_covariance), diagonal, of a still start */",
               _table("P0_DIAG", "NAME_real", np.diag(F._initial_covariance(cfg)), lit), "",
               _prm_struct(params, bool(prop["rk4"]), real), "",
               "/* strapdown.ahrs.flags.MeasurementFlag */",
