@@ -8,6 +8,7 @@ from __future__ import annotations
 import os
 import re
 import subprocess
+import time
 from pathlib import Path
 
 import numpy as np
@@ -87,3 +88,57 @@ def pytest_xdist_make_scheduler(config, log):
             return module if shared[module] else nodeid
 
     return ModuleFixtureScheduling(config, log)
+
+
+#: strapdown.warmup's parts, each with its compile time on a cold cache (s, this machine):
+#: the AHRS filter is one kernel of ~33 s, the attitude algorithms ~11 s, navigation ~7 s.
+WARM_PARTS = {"ahrs": 33.0, "attitude": 11.0, "navigation": 7.0}
+#: Fewer collected tests than this (a module or a package run by hand): no warm-up.
+WARM_MIN_TESTS = 300
+
+
+def _warm_shares(workers: int) -> list[list[str]]:
+    """The parts split over ``workers`` workers, longest first to the least loaded."""
+    shares: list[list[str]] = [[] for _ in range(workers)]
+    load = [0.0] * workers
+    for part, cost in sorted(WARM_PARTS.items(), key=lambda kv: -kv[1]):
+        i = load.index(min(load))
+        shares[i].append(part)
+        load[i] += cost
+    return shares
+
+
+def pytest_collection_finish(session):
+    """Under pytest-xdist, compile numba's kernels once for the whole run before any test.
+
+    On a cold cache (a fresh clone, CI) every process compiles the kernels it calls that are
+    not yet in numba's on-disk cache, and numba has no lock: the two workers, and the
+    command lines the tests start, each compiled the AHRS filter (~33 s) whenever they met it
+    before another had written it. Here each worker compiles its share of
+    ``strapdown.warmup``'s parts (written to the cache the tests and their subprocesses
+    read), then waits until every share is done; from then on every process loads them
+    (well under a second). The tests are unchanged: the same kernels, the same machine
+    code. The compile-notice tests use a cache of their own (NUMBA_CACHE_DIR), still cold."""
+    workerinput = getattr(session.config, "workerinput", None)
+    basetemp = session.config.option.basetemp
+    if workerinput is None or basetemp is None or len(session.items) < WARM_MIN_TESTS:
+        return
+    done = Path(basetemp).parent / "numba-warm"  # the run's temporary root: shared
+    done.mkdir(exist_ok=True)
+    workers = int(workerinput["workercount"])
+    index = int(workerinput["workerid"].removeprefix("gw"))
+    mine = _warm_shares(workers)[index] if index < workers else []
+    for part in mine:
+        from strapdown.apps.warmup import warmup
+
+        try:
+            warmup([part])
+            note = "ok"
+        except Exception as exc:  # the tests that call it fail, and say why
+            note = f"failed: {exc!r}"
+        (done / f"{part}.tmp").write_text(note)
+        (done / f"{part}.tmp").replace(done / part)
+    deadline = time.monotonic() + 1800.0
+    while (not all((done / part).is_file() for part in WARM_PARTS)
+           and time.monotonic() < deadline):
+        time.sleep(0.1)
