@@ -14,11 +14,19 @@ from strapdown.navigation import _kernels, navigate
 from strapdown.truth import earth
 from strapdown.truth.trajectory import EarthFlight, EarthSegment
 
+#: The flight tests share one flight's increments (``_flight``, an in-process cache): on one
+#: worker they are computed once.
+ONE_WORKER = True
 
-def _run(flight, rate, n=1, structure="conventional", bias=None):
+
+def _run(flight, rate, n=1, structure="conventional", bias=None, increments=None):
+    """Navigate ``flight``'s exact increments at ``rate``; the solution and its position
+    and velocity errors. ``increments``: those increments, computed before."""
     h = 1.0 / rate
-    edges = np.arange(round(flight.duration / h) + 1) * h
-    g, a = flight.increments(edges)
+    if increments is None:
+        edges = np.arange(round(flight.duration / h) + 1) * h
+        increments = flight.increments(edges)
+    g, a = increments
     if bias is not None:
         a = a + np.asarray(bias) * h
     s0 = flight.state(np.array([0.0]))
@@ -116,12 +124,21 @@ _FLIGHT = [EarthSegment(60), EarthSegment(120, 3.0), EarthSegment(60), EarthSegm
 
 
 @functools.cache
+def _flight(rate):
+    """The 10-minute flight and its exact increments at ``rate`` (the same for every
+    structure and N: computed once, the costly part of each test below)."""
+    fl = EarthFlight(_FLIGHT, lat_deg=45.0, lon_deg=10.0, height=1000.0, speed=100.0)
+    h = 1.0 / rate
+    return fl, fl.increments(np.arange(round(fl.duration / h) + 1) * h)
+
+
+@functools.cache
 def _flight_errors(structure, n):
     """Largest horizontal, height and velocity errors at 100 and 200 Hz, and their ratios."""
-    fl = EarthFlight(_FLIGHT, lat_deg=45.0, lon_deg=10.0, height=1000.0, speed=100.0)
     errs = []
     for rate in (100.0, 200.0):
-        _, dp, dv = _run(fl, rate, n, structure)
+        fl, increments = _flight(rate)
+        _, dp, dv = _run(fl, rate, n, structure, increments=increments)
         errs.append((np.abs(dp[:, :2]).max(), np.abs(dp[:, 2]).max(), np.abs(dv).max()))
     return np.array(errs), np.array(errs[0]) / np.array(errs[1])
 
