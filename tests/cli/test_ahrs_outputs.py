@@ -73,3 +73,33 @@ def test_a_failed_sidecar_rename_removes_the_new_attitude(tmp_path, capsys, monk
     code, err = _ahrs(tmp_path, capsys, tmp_path / "o" / "att.csv")
     assert code == 74 and "Input/output error" in err and err.count("\n") == 1
     assert list((tmp_path / "o").iterdir()) == []
+
+
+def test_a_start_in_motion_is_said_and_in_the_metadata(tmp_path, capsys):
+    """A log whose first half second turns (1 rad/s about x) starts in motion: a note on
+    stderr and ``start`` in the sidecar; a log that starts still says nothing of it."""
+    import json
+
+    import numpy as np
+
+    from strapdown.rotation.dcm import dcm_from_quat
+    from strapdown.rotation.quaternion import quat_from_rotvec
+
+    n, h = 300, 0.01
+    t = np.arange(n) * h
+    for rate, still in ((1.0, False), (0.0, True)):
+        w = np.tile([rate, 0.0, 0.0], (n, 1))
+        c = dcm_from_quat(quat_from_rotvec(np.outer(rate * t, [1.0, 0.0, 0.0])))  # C_n_b
+        a = np.einsum("nji,j->ni", c, [0.0, 0.0, 9.81])
+        m = np.einsum("nji,j->ni", c, [0.0, 20.0, -40.0])
+        rows = ["t,gx,gy,gz,ax,ay,az,mx,my,mz"]
+        rows += [",".join(repr(float(v)) for v in (t[i], *w[i], *a[i], *m[i])) for i in range(n)]
+        imu = tmp_path / f"log{rate}.csv"
+        imu.write_text("\n".join(rows) + "\n")
+        out = tmp_path / f"att{rate}.csv"
+        assert main(["ahrs", "--imu", str(imu), "--gyro-units", "rad/s", "--acc-units", "m/s2",
+                     "--out", str(out)]) == 0
+        err = capsys.readouterr().err
+        meta = json.loads(out.with_name(out.name + ".meta.json").read_text())
+        assert ("starts in motion" in err) is not still
+        assert meta["start"].startswith("still" if still else "in motion")

@@ -505,6 +505,9 @@ class AhrsResult:
         ``estimate_mag_delay``); None without a magnetometer.
     smoothed : bool
         True for :func:`offline_ekf`'s output: acausal, every row uses the whole record.
+    start_still : bool
+        The initial window was still (:func:`start_is_still`); False: the filter started
+        in motion (see the module docstring).
     """
 
     t: np.ndarray
@@ -523,6 +526,7 @@ class AhrsResult:
     acc_bias: np.ndarray | None = None
     mag_delay_s: np.ndarray | None = None
     smoothed: bool = False
+    start_still: bool = True
 
     def __post_init__(self):
         n = self.t.shape[0]
@@ -850,7 +854,7 @@ def _fill(rec, out: K.Outputs, k: int) -> np.ndarray:
 
 
 def _result(rec, out: K.Outputs, epoch, frame: str, have_mag: bool, algorithm: str,
-            cfg: AhrsConfig, smoothed: bool = False) -> AhrsResult:
+            cfg: AhrsConfig, start: _Start, smoothed: bool = False) -> AhrsResult:
     """The :class:`AhrsResult` of completed per-sample outputs (:func:`_fill`): the
     attitudes after the initial one predicted over half a sample period
     (``gyro_sample="interval"``) plus ``latency_s``, then turned into ``frame``."""
@@ -865,7 +869,7 @@ def _result(rec, out: K.Outputs, epoch, frame: str, have_mag: bool, algorithm: s
     return AhrsResult(rec.t, np.arange(rec.t.size), epoch, q, frame, have_mag, bias,
                       out.accel, out.flags, out.nis, out.attitude_sigma, algorithm, cfg,
                       out.acc_bias if cfg.estimate_acc_bias else None,
-                      out.mag_delay * rec.td if have_mag else None, smoothed)
+                      out.mag_delay * rec.td if have_mag else None, smoothed, start.still)
 
 
 class _Start(typing.NamedTuple):
@@ -967,7 +971,7 @@ def ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
     rec, acc, mag, have_mag, q_init, b0, ref, start = _setup(t, gyro, acc, mag, cfg, q0,
                                                               gyro_bias0, mag_reference, frame)
     out, epoch, _ = _filter(rec, acc, mag, have_mag, cfg, algorithm, q_init, b0, ref, start)
-    return _result(rec, out, epoch, frame, have_mag, algorithm, cfg)
+    return _result(rec, out, epoch, frame, have_mag, algorithm, cfg, start)
 
 
 def _backward(rec, acc, mag, have_mag: bool, cfg: AhrsConfig, algorithm: str, fwd, ref,
@@ -1064,7 +1068,7 @@ def offline_ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
     _to_stamps(fwd, rec.omega, rec, cfg)
     bwd, _ = _backward(rec, acc, mag, have_mag, cfg_pass, algorithm, fwd, ref, gravity)
     _combine(fwd, bwd)
-    return _result(rec, fwd, epoch, frame, have_mag, algorithm, cfg, smoothed=True)
+    return _result(rec, fwd, epoch, frame, have_mag, algorithm, cfg, start, smoothed=True)
 
 
 def _to_stamps(out: K.Outputs, omega, rec, cfg: AhrsConfig) -> None:

@@ -540,6 +540,9 @@ def _metadata(imu: Path, log: AhrsLog, res: AhrsResult, algorithm: str, frame: s
         "magnetometer_used": (res.fraction(MeasurementFlag.MAG_USED) if res.heading_observed
                               else 0.0),
         "rest_updates": res.fraction(MeasurementFlag.REST),
+        "start": ("still" if res.start_still else "in motion (the initial window is not still: "
+                  "averaged along the gyro, wider initial uncertainty, gravity's norm nominal "
+                  "until the first rest)"),
         "gyro_units": log.gyro_units, "acc_units": log.acc_units,
         "units_inferred": log.inferred, **base.to_dict(),
         "columns": ["t", "qw", "qx", "qy", "qz", "yaw_deg", "pitch_deg", "roll_deg", "bias_x",

@@ -127,6 +127,10 @@ def run(args: argparse.Namespace) -> int:
         say(f"note: {what} units inferred from the data: {unit}")
     if not res.heading_observed:
         say("warning: no magnetometer: heading is not observed (gyro integral from yaw 0)")
+    if not res.start_still:
+        say("note: the recording starts in motion (its first "
+            f"{cfg.init_window_s:g} s are not still): the first seconds converge from a "
+            "rougher start")
     print(f"wrote {args.out} ({meta['outputs']} attitudes, {meta['mode'].split(' ')[0]}, "
           f"q_n_b with n = {args.frame}; "
           f"accelerometer used {meta['accelerometer_used']:.0%}, magnetometer "
