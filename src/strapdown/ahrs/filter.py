@@ -775,15 +775,21 @@ def _propagation(a: dict) -> tuple[K.Propagation, K.Window]:
     return prop, window
 
 
-def _initial_covariance(cfg: AhrsConfig, attitude_sigma0: float | None = None) -> np.ndarray:
+def _initial_covariance(cfg: AhrsConfig, attitude_sigma0: float | None = None,
+                        yaw_known_about=None) -> np.ndarray:
     """P0: attitude (``attitude_sigma0``, default the config's; :class:`_Start` widens it
-    after a start in motion), gyro bias (and the raw model's manoeuvre acceleration, the
-    accelerometer bias)."""
+    after a start in motion — about every axis but ``yaw_known_about``, the reference
+    vertical in the body, when given: without a magnetometer the start's yaw is a
+    convention, not an estimate, and keeps the config's σ), gyro bias (and the raw model's
+    manoeuvre acceleration, the accelerometer bias)."""
     singer = cfg.acc_model == "raw"
     nx = 6 + 3 * singer + 3 * cfg.estimate_acc_bias
     P0 = np.zeros((nx, nx))
     sigma = cfg.attitude_sigma0 if attitude_sigma0 is None else attitude_sigma0
     P0[:3, :3] = np.eye(3) * sigma**2
+    if yaw_known_about is not None:
+        u = np.asarray(yaw_known_about, float)
+        P0[:3, :3] -= (sigma**2 - cfg.attitude_sigma0**2) * np.outer(u, u)
     P0[3:6, 3:6] = np.eye(3) * cfg.gyro_bias_sigma0**2
     if singer:
         P0[6:9, 6:9] = np.eye(3) * cfg.singer_sigma**2
@@ -918,7 +924,12 @@ def _filter(rec, acc, mag, have_mag: bool, cfg: AhrsConfig, algorithm: str, q_in
     covariances when ``store_covariance``), the epoch mask, and gravity's norm at the
     end, with whether a rest measured it (``(g, known)``)."""
     prop, window = _propagation(_algorithm(algorithm))
-    init = K.Initial(q_init, b0, _initial_covariance(cfg, start.attitude_sigma0))
+    up = None  # without a magnetometer a widened start keeps the yaw's σ (a convention)
+    if not have_mag and start.attitude_sigma0 != cfg.attitude_sigma0:
+        from strapdown.rotation.dcm import dcm_from_quat
+
+        up = dcm_from_quat(q_init)[2]  # the reference vertical in the body: C_n_b's third row
+    init = K.Initial(q_init, b0, _initial_covariance(cfg, start.attitude_sigma0, up))
     params = _params(cfg, ref, have_mag, rec.td, prop.stride * rec.td, start)._replace(
         store_covariance=store_covariance)
     out, k, gravity = _run(rec, acc, mag, prop, window, params, init)
