@@ -566,7 +566,7 @@ def test_heading_innovation_is_wrapped(k):
 def _consider(k, P, H, r, y, gate=1e9, force=False):
     dx = np.zeros(P.shape[0])
     out = k._consider_update(P, H, r, y, gate, True, force, dx, C_HAT, np.empty(P.shape[0]),
-                             np.empty(P.shape[0]))
+                             np.empty(P.shape[0]), 6)
     return out, dx
 
 

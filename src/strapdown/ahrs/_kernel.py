@@ -1066,13 +1066,14 @@ def _heading_model(params, C, mn, dx, H, y):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _consider_update(P, H, r, y, gate, gating, force, dx, C, u, K):
+def _consider_update(P, H, r, y, gate, gating, force, dx, C, u, K, nb):
     """A gated scalar update whose gain is kept off roll and pitch; returns (NIS, accepted).
 
     ``S = H P Hᵀ + r`` with the full H (heading and, through the dip, tilt), so the
     heading measurement weighs less while the tilt is uncertain; the gain
     ``K = P Hᵀ / S`` is then projected: its attitude part onto the reference vertical
-    (c = C₃ᵀ in the body frame), zero on states beyond the gyro bias, and P takes the
+    (c = C₃ᵀ in the body frame), zero on the states from ``nb`` on (6: beyond the gyro
+    bias; 3: the gyro bias too, while a start in motion's heading is recovered), and P takes the
     Joseph form for that gain, ``P − K uᵀ − u Kᵀ + S K Kᵀ`` (u = P Hᵀ), exact for any
     gain. dx += K y. Work arrays u, K (n,).
     """
@@ -1088,7 +1089,7 @@ def _consider_update(P, H, r, y, gate, gating, force, dx, C, u, K):
         return nis, False
     kz = (C[2, 0] * u[0] + C[2, 1] * u[1] + C[2, 2] * u[2]) / S
     for i in range(n):
-        K[i] = C[2, i] * kz if i < 3 else (u[i] / S if i < 6 else 0.0)
+        K[i] = C[2, i] * kz if i < 3 else (u[i] / S if i < nb else 0.0)
     for i in range(n):
         for j in range(n):
             P[i, j] += S * K[i] * K[j] - K[i] * u[j] - u[i] * K[j]
@@ -1365,7 +1366,10 @@ def ekf_kernel(sensors, prop, window, params, init, out):
                                                * (_disturbed_factor(params, nd, ms) if dist
                                                   else 1.0),
                                                y1, params.mag_gate,
-                                               params.gating, force, dx, C, ku, kk)
+                                               params.gating, force, dx, C, ku, kk,
+                                               # the recovered heading of a start in motion
+                                               # is the start's error, not the gyro bias's
+                                               3 if provisional else 6)
                 bits, mag_bad_since = _outcome(ok, tk, mag_bad_since, F_MAG_USED,
                                                F_MAG_REJECTED)
                 flags |= bits
