@@ -27,10 +27,10 @@ def quat_close(p, q, atol):
     return np.all(d <= atol)
 
 
-def _broad_dir() -> Path | None:
-    """The BROAD trials: $STRAPDOWN_BROAD, else ``shared/data/broad`` beside this checkout,
-    else beside the checkout this one was cloned from (CI clones into a temporary directory)."""
-    env = os.environ.get("STRAPDOWN_BROAD")
+def _shared_dir(name: str, env_var: str) -> Path | None:
+    """A shared data set: ``$env_var``, else ``shared/data/NAME`` beside this checkout, else
+    beside the checkout this one was cloned from (CI clones into a temporary directory)."""
+    env = os.environ.get(env_var)
     if env:
         return Path(env)
     repo = Path(__file__).resolve().parents[1]
@@ -43,13 +43,15 @@ def _broad_dir() -> Path | None:
     if origin and Path(origin).is_dir():
         roots.append(Path(origin).resolve())
     for root in roots:
-        cand = root.parent / "shared" / "data" / "broad"
+        cand = root.parent / "shared" / "data" / name
         if cand.is_dir():
             return cand
     return None
 
 
-BROAD = _broad_dir()
+BROAD = _shared_dir("broad", "STRAPDOWN_BROAD")
+#: The OpenAXES recordings, found as BROAD's are (a path that may not exist when absent).
+OPENAXES = _shared_dir("openaxes", "STRAPDOWN_OPENAXES") or Path("/nonexistent/openaxes")
 
 
 _SHARED_FIXTURE = re.compile(r"""@pytest\.fixture\([^)]*scope\s*=\s*["'](?:module|class|package)""")

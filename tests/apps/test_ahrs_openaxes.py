@@ -7,17 +7,15 @@ from __future__ import annotations
 
 import csv
 import math
-import os
-from pathlib import Path
 
 import pytest
 
+from conftest import OPENAXES
 from strapdown.apps.ahrs_openaxes import FILTERS, rows, summary_table
 from strapdown.cli import main
 from strapdown.io.openaxes import ENV
 
-_SHARED = Path(os.environ.get(ENV) or Path(__file__).resolve().parents[3] / "shared" / "data"
-               / "openaxes")
+_SHARED = OPENAXES
 
 
 def _errors(total: float, incl: float) -> dict:

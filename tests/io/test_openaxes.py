@@ -4,12 +4,12 @@ and the reference, a TIME that does not increase uniformly, NaN)."""
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from conftest import OPENAXES
 from strapdown._core.errors import InputError
 from strapdown.io.openaxes import (
     ENV,
@@ -131,8 +131,7 @@ def test_missing_files_nan_and_zero_quaternions_are_refused(tmp_path):
         read_openaxes(tmp_path / "z", "carpus")
 
 
-_SHARED = Path(os.environ.get(ENV) or Path(__file__).resolve().parents[3] / "shared" / "data"
-               / "openaxes")
+_SHARED = OPENAXES
 
 
 @pytest.mark.skipif(not _SHARED.is_dir(), reason=f"no OpenAXES data (${ENV})")
