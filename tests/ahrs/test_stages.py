@@ -711,9 +711,12 @@ def test_disturbed_factor_and_mag_recovery(k):
     nd = np.array([REF[0] * 1.05, REF[1] - 0.1])  # inside: at least 1
     assert k._disturbed_factor(p, nd, ms) == pytest.approx(3.0, rel=1e-15)
     P = np.zeros((6, 6))
-    assert k._mag_recovery(p, P, C_HAT) == K.F_MAG_RECOVERED
+    assert k._mag_recovery(p, P, C_HAT, 1.0) == K.F_MAG_RECOVERED
     assert np.allclose(P[:3, :3], 0.01 * np.outer(C_HAT[2], C_HAT[2]), rtol=0, atol=1e-17)
     assert not P[3:].any()
+    P[:] = 0.0  # a start in motion's heading over a 2.5 ms epoch: a quarter of that
+    k._mag_recovery(p, P, C_HAT, 0.0025 / K.PROVISIONAL_RECOVER_S)
+    assert np.allclose(P[:3, :3], 0.0025 * np.outer(C_HAT[2], C_HAT[2]), rtol=0, atol=1e-17)
 
 
 @pytest.mark.parametrize("delay", [0, 2, 4])

@@ -88,6 +88,9 @@ M_NORM, M_DIP, M_UNDIST, M_DIST, M_CNORM, M_CDIP, M_CT, M_REJECT = range(8)
 #: The slow mean of the low-passed specific force (:func:`_motion_power`) has this many
 #: times the low-pass's time constant.
 MOTION_SLOW = 4.0
+#: After a start in motion the heading is recovered by ``recover_angle²`` per this many
+#: seconds (:func:`_mag_recovery`), whatever the sample rate.
+PROVISIONAL_RECOVER_S = 0.01
 
 
 class Sensors(NamedTuple):
@@ -1032,10 +1035,12 @@ def _disturbed_factor(params, nd, ms):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _mag_recovery(params, P, C):
-    """Stage 6, recovery: inflate the heading covariance (about the reference vertical);
-    returns its flag."""
-    ra = params.recover_angle ** 2
+def _mag_recovery(params, P, C, scale):
+    """Stage 6, recovery: inflate the heading covariance (about the reference vertical) by
+    ``recover_angle²`` times ``scale`` (1 for a recovery that is due; ``T /``
+    :data:`PROVISIONAL_RECOVER_S` for a start in motion's heading, so that it follows the
+    field at the same rate at 50 Hz as at 286 Hz); returns its flag."""
+    ra = params.recover_angle ** 2 * scale
     for r in range(3):
         for s in range(3):
             P[r, s] += ra * C[2, r] * C[2, s]
@@ -1356,11 +1361,14 @@ def ekf_kernel(sensors, prop, window, params, init, out):
                 flags |= F_MAG_DISTURBED
             if horizontal and not (dist and ms[M_REJECT] <= params.mag_reject_s):
                 # after a start in motion the heading follows the field (recovered every
-                # epoch) while the tilt, and with it the measured heading, converges
-                force = provisional or _recovery_due(params.gating, not dist, mag_bad_since, tk,
-                                                     params.recover_mag_s)
+                # epoch, at a rate in time) while the tilt, and with it the measured heading,
+                # converges
+                due = _recovery_due(params.gating, not dist, mag_bad_since, tk,
+                                    params.recover_mag_s)
+                force = due or provisional
                 if force:
-                    flags |= _mag_recovery(params, P, C)
+                    flags |= _mag_recovery(params, P, C,
+                                           1.0 if due else T / PROVISIONAL_RECOVER_S)
                 _heading_model(params, C, mn, dx, H_mag, y1)
                 nis_mag, ok = _consider_update(P, H_mag, params.heading_noise ** 2 / T
                                                * (_disturbed_factor(params, nd, ms) if dist

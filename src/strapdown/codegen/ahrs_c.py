@@ -158,6 +158,7 @@ def _constants(cfg: AhrsConfig, params: K.Params, prop: dict, h: float, mag: boo
               "MOVING_SIGMA0_SQ": _lit(cfg.moving_start_sigma0 ** 2, real),
               "MOVING_MAG_S": _lit(cfg.moving_start_mag_s, real),
               "SETTLE_ALWAYS": str(int(cfg.acc_lowpass_settle)),
+              "PROVISIONAL_S": _lit(K.PROVISIONAL_RECOVER_S, real),
               **_epoch_constants(cfg, params, prop, h, real)}
     lines = [f"#define PREFIX_{k} {v}" for k, v in macros.items()]
     lit = lambda v: _lit(v, real)  # noqa: E731
