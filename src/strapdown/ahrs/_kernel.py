@@ -1282,11 +1282,12 @@ def ekf_kernel(sensors, prop, window, params, init, out):
         acc_quiet, at_rest = _rest_detect(ema_n, rest_alpha, params, gm, g2, am, a2, g_meas)
         at_rest = at_rest and _rest_still(k, x, acc, h, is_rate, params, gm, am)
         rest_since = (rest_since if rest_since >= 0.0 else tk) if at_rest else -1.0
-        if not g_known and at_rest and tk - rest_since >= params.rest_min_s:
+        rest_held = at_rest and tk - rest_since >= params.rest_min_s
+        if not g_known and rest_held:
             # a moving start's gravity, measured at its first rest
             g_meas = np.sqrt(am[0] ** 2 + am[1] ** 2 + am[2] ** 2)
             g_known = True
-        if params.rest_update and at_rest and tk - rest_since >= params.rest_min_s:
+        if params.rest_update and rest_held:
             _rest_model(params, bias, gm, dx, y3)
             _gated_update(P, H_rest, 6, params.rest_noise ** 2 / T, y3, 0.0, False, True, False,
                           dx, U3, S3, Si3)
