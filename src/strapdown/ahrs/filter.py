@@ -651,13 +651,14 @@ def _still(rec, acc, cfg: AhrsConfig) -> bool:
                 and np.sum(np.var(a, axis=0)) < cfg.rest_acc ** 2)
 
 
-def _derotated(rec, x, w: int) -> np.ndarray:
-    """The first ``w`` rows of ``x`` (body-frame vectors) turned into the first sample's
-    body frame along the gyro's attitude (``rate-single``)."""
+def _derotated(rec, x, w: int, q0=None) -> np.ndarray:
+    """The first ``w`` rows of ``x`` (body-frame vectors) turned along the gyro's attitude
+    (``rate-single``) from the first sample into the frame that ``q0`` (default: identity,
+    the first sample's body frame) relates the first sample to."""
     from strapdown.algorithms.rate import rate_attitude
     from strapdown.rotation.dcm import dcm_from_quat
 
-    q = rate_attitude(rec.t[:w], rec.omega[:w], algorithm="rate-single").q
+    q = rate_attitude(rec.t[:w], rec.omega[:w], algorithm="rate-single", q0=q0).q
     return np.einsum("nij,nj->ni", dcm_from_quat(q), x[:w])
 
 
@@ -698,11 +699,7 @@ def _reference_field(rec, mag, q_init, m0, q0, mag_reference, cfg: AhrsConfig):
     elif q0 is None:
         mn = dcm_from_quat(q_init) @ m0
     else:  # learn the field over the window along the gyro-propagated attitude
-        from strapdown.algorithms.rate import rate_attitude
-
-        w = _init_window(rec, cfg)
-        qw = rate_attitude(rec.t[:w], rec.omega[:w], algorithm="rate-single", q0=q_init).q
-        mn = np.einsum("nij,nj->ni", dcm_from_quat(qw), mag[:w]).mean(axis=0)
+        mn = _derotated(rec, mag, _init_window(rec, cfg), q_init).mean(axis=0)
     return (float(np.linalg.norm(mn)), math.atan2(-mn[2], math.hypot(mn[0], mn[1])),
             math.atan2(mn[1], mn[0]))
 
