@@ -226,6 +226,18 @@ class AhrsConfig:
         BROAD's 2 cm attached-magnet trial the smoothed estimate was 3.85° against
         the forward pass's 1.99° (with ``math.inf``: 1.96°). Not cross-validated;
         chosen on all fifteen trials (docs/reproductions.md).
+    offline_smooth_s : float
+        The last step of :func:`offline_ekf`: what of the combined attitude varies faster
+        than this (s) about the bias-corrected gyro's own path is removed — the
+        correction from that path is low-passed forward and backward (second-order
+        Butterworth, cut-off √2/(2πτ), zero phase). Over seconds the gyro is the better
+        sensor; what moves the estimate off its path at a swing's or a shake's frequency
+        is the low-passed accelerometer's residual motion (the causal low-pass's ripple,
+        the same in both passes, so the two-filter combination keeps it). Default 4, 0
+        switches it off. Chosen on the generalisation suite (seeds 0–2, from 1, 2.1, 4 and
+        8 s; error after fitting a constant world and body alignment: pendulums
+        1.4–1.6× offlineVQF → 0.3–1.4×), checked held out on BROAD and OpenAXES
+        (docs/reproductions.md).
     mag_delay_s : float
         Delay of the magnetometer behind the gyro, s: each field sample is rotated
         with the attitude of that long ago (rounded to whole filter epochs). With
@@ -388,6 +400,7 @@ class AhrsConfig:
     mag_disturbed_power: float = 0.0
     offline_heading_rate_noise: float = 0.0
     offline_mag_reject_s: float = math.inf
+    offline_smooth_s: float = 4.0
     mag_delay_s: float = 0.0
     estimate_mag_delay: bool = True
     mag_delay_max_s: float = 0.02
@@ -455,7 +468,7 @@ class AhrsConfig:
 _MAY_BE_INFINITE = ("mag_reject_s", "offline_mag_reject_s")
 _ANY_SIGN = ("declination_deg",)
 _NON_NEGATIVE = ("lever_arm", "acc_motion_leak", "tilt_rate_noise", "heading_rate_noise",
-                 "offline_heading_rate_noise",
+                 "offline_heading_rate_noise", "offline_smooth_s",
                  "mag_reject_s", "rest_min_s", "mag_delay_s", "latency_s", "mag_delay_max_s",
                  "mag_disturbed_power", "offline_mag_reject_s", "mag_delay_z")
 
@@ -1042,6 +1055,35 @@ def _combine(fwd, bwd) -> None:
     fwd.bias_var[:] = 1.0 / (wf + wb)
 
 
+def _gyro_smooth(rec, out: K.Outputs, cfg: AhrsConfig) -> None:
+    """In place on the combined passes (at the stamps): ``q ← LP(c) ⊗ q_g``, where ``q_g``
+    is the bias-corrected gyro's own path (:func:`_kernel.gyro_path`, the combined bias),
+    ``c = q ⊗ q_g*`` the correction from it in the reference frame, made sign-continuous,
+    and LP the second-order Butterworth of time constant ``offline_smooth_s`` (cut-off
+    √2/(2πτ)) run forward and backward on c's components, then normalised
+    (``AhrsConfig.offline_smooth_s``). Skipped when off, or when the record is too short
+    or the cut-off above half the sample rate."""
+    from scipy.signal import butter, sosfiltfilt
+
+    tau, n = cfg.offline_smooth_s, rec.t.size
+    fc = math.sqrt(2.0) / (2.0 * math.pi * tau) if tau > 0 else math.inf
+    if not fc < 0.5 / rec.td or n <= _SMOOTH_PAD:
+        return
+    q_g = np.empty_like(out.q)
+    K.gyro_path(rec.omega, out.gyro_bias, float(rec.td), cfg.gyro_sample == "interval", q_g)
+    c = quat_multiply(out.q, q_g * np.array([1.0, -1.0, -1.0, -1.0]))
+    flip = np.einsum("ij,ij->i", c[1:], c[:-1]) < 0
+    c[1:] *= np.where(np.logical_xor.accumulate(flip), -1.0, 1.0)[:, None]
+    c = sosfiltfilt(butter(2, fc, fs=1.0 / rec.td, output="sos"), c, axis=0,
+                    padlen=_SMOOTH_PAD)
+    out.q[:] = quat_multiply(c / np.linalg.norm(c, axis=1, keepdims=True), q_g)
+
+
+#: Samples padded at each end by :func:`_gyro_smooth`'s zero-phase filter (scipy's
+#: default for one second-order section); a record must be longer.
+_SMOOTH_PAD = 9
+
+
 def offline_ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
                 config: AhrsConfig | None = None, q0=None, gyro_bias0=None,
                 mag_reference=None, frame: str = "ENU") -> AhrsResult:
@@ -1058,7 +1100,9 @@ def offline_ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
     of the stamp for the two) and combined sample by sample by the two-filter
     (Fraser–Potter) rule, each weighted by its attitude covariance — so the
     low-pass lag of one pass cancels the lead of the other, and the first seconds,
-    where the forward filter is still converging, get the backward estimate. Arguments
+    where the forward filter is still converging, get the backward estimate; last, what
+    of the combination varies faster than ``offline_smooth_s`` about the bias-corrected
+    gyro's own path is removed (zero-phase; :class:`AhrsConfig`). Arguments
     as for :func:`ekf`; the result has ``smoothed`` set, its flags, NIS and
     manoeuvre acceleration are the forward pass's.
 
@@ -1076,6 +1120,7 @@ def offline_ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
     _to_stamps(fwd, rec.omega, rec, cfg)
     bwd, _ = _backward(rec, acc, mag, have_mag, cfg_pass, algorithm, fwd, ref, gravity)
     _combine(fwd, bwd)
+    _gyro_smooth(rec, fwd, cfg)
     return _result(rec, fwd, epoch, frame, have_mag, algorithm, cfg, start, smoothed=True)
 
 

@@ -1,0 +1,123 @@
+"""The offline filter's last step: the combined attitude kept to the gyro's own path at high
+frequencies (``AhrsConfig.offline_smooth_s``; :func:`strapdown.ahrs.filter._gyro_smooth`),
+and the gyro path it uses (:func:`strapdown.ahrs._kernel.gyro_path`)."""
+
+from __future__ import annotations
+
+import math
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+import strapdown.ahrs._kernel as K
+from strapdown.ahrs.filter import AhrsConfig, _gyro_smooth
+from strapdown.algorithms.rate import rate_attitude
+from strapdown.rotation.quaternion import (
+    quat_conjugate,
+    quat_from_rotvec,
+    quat_multiply,
+    rotvec_from_quat,
+)
+from strapdown.truth.motions import SpinConing
+
+
+def _motion():
+    return SpinConing(math.radians(20.0), 2 * math.pi * 0.3, math.radians(30.0))
+
+
+def _same_rotation(a, b, atol):
+    """q ≡ −q: the rows of a and b, b's signs matched to a's, agree to atol."""
+    s = np.where(np.einsum("ij,ij->i", a, b) < 0, -1.0, 1.0)[:, None]
+    return np.allclose(a, s * b, rtol=0, atol=atol)
+
+
+def _rates(n, h, bias):
+    t = np.arange(n) * h
+    return t, _motion().rate(t) + bias
+
+
+def test_gyro_path_of_point_samples_is_rate_single():
+    """Point samples: the library's rate-single algorithm on the bias-corrected rates, from
+    the identity (a constant bias, so both see the same corrected samples)."""
+    h, b = 0.01, np.array([0.01, -0.02, 0.005])
+    t, w = _rates(500, h, b)
+    out = np.empty((t.size, 4))
+    K.gyro_path(w, np.tile(b, (t.size, 1)), h, False, out)
+    ref = rate_attitude(t, w - b, algorithm="rate-single", q0=[1.0, 0.0, 0.0, 0.0]).q
+    assert ref.shape == out.shape and _same_rotation(out, ref, 1e-12)
+
+
+def test_gyro_path_of_interval_samples_turns_by_each_mean_rate():
+    """Interval samples: each row turned by ``td (ω_k − b_k)`` from the row before, the
+    bias of its own row (scipy's rotations composed)."""
+    rng = np.random.default_rng(3)
+    h = 0.005
+    t, w = _rates(400, h, 0.0)
+    bias = 0.01 * rng.standard_normal((t.size, 3))
+    out = np.empty((t.size, 4))
+    K.gyro_path(w, bias, h, True, out)
+    r = Rotation.identity()
+    ref = [r]
+    for k in range(1, t.size):
+        r = r * Rotation.from_rotvec(h * (w[k] - bias[k]))
+        ref.append(r)
+    ref_q = np.stack([x.as_quat(scalar_first=True) for x in ref])
+    assert _same_rotation(out, ref_q, 1e-12)
+    slow = np.empty_like(out)
+    K.gyro_path.py_func(w, bias, h, True, slow)
+    assert np.allclose(out, slow, rtol=0, atol=1e-14)
+
+
+def _smoothed(err, tau=4.0, h=0.02, n=15000):
+    """A spin-coning body's point-sample rates, the attitude they give (the truth here, so
+    that the gyro path holds no error of its own) and an estimate off it by the
+    reference-frame rotation vector ``err(t)``; returns (t, the error left after the
+    smoothing, as a rotation vector)."""
+    t, w = _rates(n, h, 0.0)
+    q_true = np.empty((n, 4))
+    K.gyro_path(w, np.zeros((n, 3)), h, False, q_true)
+    q_est = quat_multiply(quat_from_rotvec(err(t)), q_true)
+    out = SimpleNamespace(q=q_est.copy(), gyro_bias=np.zeros((n, 3)))
+    rec = SimpleNamespace(t=t, td=h, omega=w)
+    _gyro_smooth(rec, out, AhrsConfig(gyro_sample="point", offline_smooth_s=tau))
+    left = quat_multiply(out.q, quat_conjugate(q_true))
+    return t, rotvec_from_quat(left * np.where(left[:, :1] < 0, -1.0, 1.0))
+
+
+def test_smoothing_keeps_a_slow_correction_and_removes_a_fast_one():
+    """A constant error is kept (the zero-phase low-pass passes it) and a 0.5 Hz one is
+    attenuated by the Butterworth's squared magnitude 1/(1 + (f/f_c)⁴) (f_c = √2/(2πτ),
+    τ = 4 s: 1.6e-4): of 0.01 rad, 1.6e-6 rad is left. Middle of the record (the ends
+    carry the zero-phase filter's transients); second-order terms of 1e-2 rad errors
+    (the low-pass acts on quaternion components) bound the tolerance."""
+    c0 = np.array([0.02, -0.01, 0.015])
+    amp = np.array([0.01, 0.01, -0.01])
+    t, left = _smoothed(lambda t: c0 + amp * np.sin(2 * np.pi * 0.5 * t)[:, None])
+    mid = (t > 60) & (t < t[-1] - 60)
+    assert np.max(np.abs(left[mid] - c0)) < 1e-5
+
+
+def test_smoothing_at_the_cut_off_halves_the_error_without_delaying_it():
+    """At the cut-off frequency the forward-backward Butterworth passes half the amplitude
+    (|H|² = 1/2) with zero phase."""
+    tau = 4.0
+    fc = math.sqrt(2) / (2 * math.pi * tau)
+    amp = 0.004
+    t, left = _smoothed(lambda t: np.outer(amp * np.sin(2 * np.pi * fc * t), [1.0, 0.5, -1.0]),
+                        tau=tau)
+    mid = (t > 100) & (t < t[-1] - 100)
+    expect = np.outer(0.5 * amp * np.sin(2 * np.pi * fc * t), [1.0, 0.5, -1.0])
+    assert np.max(np.abs(left[mid] - expect[mid])) < 2e-5
+
+
+def test_smoothing_off_leaves_the_estimate_alone():
+    err = lambda t: np.outer(0.01 * np.sin(2 * np.pi * 0.5 * t), [1.0, 0.0, 0.0])  # noqa: E731
+    t, left = _smoothed(err, tau=0.0, n=2000)
+    assert np.allclose(left, err(t), rtol=0, atol=1e-12)
+
+
+def test_offline_smooth_s_must_be_non_negative():
+    with pytest.raises(ValueError, match="offline_smooth_s"):
+        AhrsConfig(offline_smooth_s=-1.0)
