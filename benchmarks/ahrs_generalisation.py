@@ -1,13 +1,15 @@
 """The AHRS generalisation suite over several seeds: our filter and VQF on simulated recordings.
 
-Usage: ``python benchmarks/ahrs_generalisation.py [--seeds 0 1 2 3 4] [--out
+Usage: ``python benchmarks/ahrs_generalisation.py [--seeds 0 1 2 3 4] [--aligned] [--out
 reports/ahrs_generalisation.json]``.
 
 Each seed draws the sensor errors and the random parts of the motions
 (:func:`strapdown.truth.scenarios.suite`, :func:`~strapdown.truth.scenarios.record`); each
 scenario is run by ``strapdown EKF`` and ``VQF`` (causal), ``strapdown EKF offline`` and
 ``offlineVQF`` (acausal), scored by BROAD's metric from 5 s on
-(:func:`strapdown.apps.ahrs_generalisation.evaluate`). Prints, per scenario, the mean over
+(:func:`strapdown.apps.ahrs_generalisation.evaluate`); with ``--aligned``, after fitting a
+constant world and body rotation to each estimate instead (the metric of the issue's held-back
+recordings). Prints, per scenario, the mean over
 the seeds of total / inclination RMSE and the geometric mean of ours/VQF (total), and the
 worst seed's ratio; ``strapdown benchmark-ahrs --suite generalisation`` is one seed of it.
 """
@@ -30,6 +32,8 @@ _PAIRS = (("strapdown EKF", "VQF"), ("strapdown EKF offline", "offlineVQF"))
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2, 3, 4])
+    ap.add_argument("--aligned", action="store_true",
+                    help="score after fitting a constant world and body rotation")
     ap.add_argument("--out", default=None, help="write every figure as JSON here")
     args = ap.parse_args(argv)
     per_seed = {}
@@ -38,7 +42,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"seed {seed}", file=sys.stderr)
         scenarios = suite(seed)
         names = [s.name for s in scenarios]
-        per_seed[seed] = evaluate(scenarios, seed=seed)
+        per_seed[seed] = evaluate(scenarios, seed=seed, aligned=args.aligned)
     header = ["scenario", *FILTERS, "ours/VQF causal (worst)", "ours/VQF offline (worst)"]
     print("| " + " | ".join(header) + " |\n|" + "---|" * len(header))
     record = []
@@ -57,8 +61,10 @@ def main(argv: list[str] | None = None) -> int:
             entry[f"{a} / {b}"] = rs
         print("| " + " | ".join(cells) + " |")
         record.append(entry)
-    print(f"\ncells: mean over seeds {args.seeds} of total / inclination RMSE (°, BROAD's "
-          "metric from 5 s); ratios: geometric mean over the seeds (worst seed)")
+    metric = ("after fitting a constant world and body rotation" if args.aligned
+              else "BROAD's metric")
+    print(f"\ncells: mean over seeds {args.seeds} of total / inclination RMSE (°, {metric}, "
+          "from 5 s); ratios: geometric mean over the seeds (worst seed)")
     if args.out:
         Path(args.out).parent.mkdir(parents=True, exist_ok=True)
         Path(args.out).write_text(json.dumps({"seeds": args.seeds, "scenarios": record},
