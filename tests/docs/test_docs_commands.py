@@ -4,8 +4,9 @@ written and exits with status 0.
 Each document's ```sh blocks run in order in one fresh temporary directory that holds only a
 link to the checkout's ``examples/`` (as a fresh clone would), in one simulated shell whose
 working directory carries over from command to command (``cd work`` stays in effect);
-``python`` and ``strapdown`` are this interpreter's. A command is skipped only when its
-trailing comment marks it, and the skip says why:
+``python`` and ``strapdown`` are this interpreter's (a plain ``strapdown …`` or
+``python SCRIPT.py …`` line runs in this process, as tests/inprocess.py says). A command is
+skipped only when its trailing comment marks it, and the skip says why:
 
 - ``# long: …`` — a long run (benchmarks, the slower reproductions, each also covered by its
   own test); set ``STRAPDOWN_DOCS_LONG=1`` to run them too (then a quoted ``about N s`` or
@@ -32,6 +33,7 @@ from pathlib import Path
 import pytest
 
 from conftest import BROAD
+from inprocess import in_process_argvs, run_in_process
 
 REPO = Path(__file__).resolve().parents[2]
 LONG = os.environ.get("STRAPDOWN_DOCS_LONG") == "1"
@@ -137,6 +139,11 @@ class Session:
                 self.results[cmd.index] = None if _skip_reason(cmd) else self._run(cmd.line)
 
     def _run(self, line: str) -> Result:
+        argvs = in_process_argvs(line, self.env)
+        if argvs is not None:  # no shell needed: the same argv, without a new interpreter
+            t0 = time.perf_counter()
+            code, out, err = run_in_process(argvs, self.cwd, self.env)
+            return Result(code, out, err, time.perf_counter() - t0)
         state = self.root / ".cwd"
         script = f"cd {shlex.quote(str(self.cwd))} || exit 99\n{line}\nrc=$?\n" \
                  f"pwd > {shlex.quote(str(state))}\nexit $rc\n"

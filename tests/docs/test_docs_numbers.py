@@ -28,7 +28,8 @@ the printed value rounded to the quoted number of significant digits is the quot
 (``−`` is a minus; trailing zeros count: ``0.9970`` is four digits).
 
 Each source runs once, in a fresh temporary directory that holds only a link to the checkout's
-``examples/``, with ``python`` and ``strapdown`` this interpreter's (as
+``examples/``, with ``python`` and ``strapdown`` this interpreter's (a plain command line in
+this process, tests/inprocess.py; as
 ``tests/docs/test_docs_commands.py`` runs the documented commands). A source marked
 ``(long)`` — a reproduction of minutes — runs only with ``STRAPDOWN_DOCS_LONG=1``; its
 numbers are skipped otherwise, saying so. Adding a number is adding a marker after it (and a
@@ -51,6 +52,8 @@ from functools import cache
 from pathlib import Path
 
 import pytest
+
+from inprocess import in_process_argvs, run_in_process
 
 REPO = Path(__file__).resolve().parents[2]
 LONG = os.environ.get("STRAPDOWN_DOCS_LONG") == "1"
@@ -153,6 +156,13 @@ def run_source(tmp_path_factory):
     def run_command(command: str, name: str) -> Output:
         cwd = tmp_path_factory.mktemp(f"numbers-{name}")
         (cwd / "examples").symlink_to(REPO / "examples", target_is_directory=True)
+        argvs = in_process_argvs(command, env)
+        if argvs is not None:  # no shell needed: the same argv, without a new interpreter
+            code, stdout, stderr = run_in_process(argvs, cwd, env)
+            if code:
+                return Output(cwd, stdout, f"source {name}: `{command}` exited {code}:\n"
+                                           f"{stderr[-3000:]}")
+            return Output(cwd, stdout)
         try:
             proc = subprocess.run(["bash", "-c", command], cwd=cwd, env=env,
                                   capture_output=True, text=True, timeout=1800)
