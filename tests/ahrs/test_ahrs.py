@@ -588,3 +588,36 @@ def test_a_record_cut_in_motion_converges(name, causal_deg, offline_deg):
         r = run(t, g, a, m)
         assert not r.start_still
         assert broad_errors(r.q, rec.q_n_b[i0:], t >= 5.0)["total_deg"] < bound, run.__name__
+
+
+def test_a_still_window_measures_the_gyro_bias():
+    """A still initial window is a rest: the filter starts from its mean rate as the gyro
+    bias, with the σ a zero-rate update over that long a rest gives (``rest_noise /
+    √init_window_s``); a given ``gyro_bias0`` is kept, with ``gyro_bias_sigma0``; a start
+    in motion starts from zero."""
+    from strapdown.ahrs import filter as F
+    from strapdown.truth.scenarios import record, suite
+
+    h = 0.01
+    t = np.arange(400) * h
+    bias = np.array([0.004, -0.006, 0.009])
+    _q, w, acc, mag = _imu(_motion(), t, bias=bias)
+    w[:100] = bias + np.random.default_rng(5).normal(0.0, 1e-3, (100, 3))  # still 1 s
+    acc[:100], mag[:100] = acc[0], mag[0]
+    cfg = AhrsConfig()
+    n = round(cfg.init_window_s / h)
+    r = ekf(t, w, acc, mag)
+    assert r.start_still
+    assert np.array_equal(r.gyro_bias[0], w[:n].mean(axis=0))
+    start = F._setup(t, w, acc, mag, cfg, None, None, None, "ENU")[-1]
+    assert start.gyro_bias_sigma0 == pytest.approx(cfg.rest_noise / math.sqrt(n * h), rel=1e-12)
+    assert start.gyro_bias_sigma0 < cfg.gyro_bias_sigma0
+    given = ekf(t, w, acc, mag, gyro_bias0=[0.001, 0.0, 0.0])
+    assert np.array_equal(given.gyro_bias[0], [0.001, 0.0, 0.0])
+    assert F._setup(t, w, acc, mag, cfg, None, [0.001, 0.0, 0.0], None, "ENU")[-1] \
+        .gyro_bias_sigma0 is None  # the config's
+    k, sc = next((k, s) for k, s in enumerate(suite(0)) if s.name == "spin-coning")
+    rec = record(sc, np.random.SeedSequence([0, k]), duration_s=20.0)
+    i0 = int(np.searchsorted(rec.t, 15.0))
+    moving = ekf(rec.t[i0:] - rec.t[i0], rec.gyro[i0:], rec.acc[i0:], rec.mag[i0:])
+    assert not moving.start_still and np.array_equal(moving.gyro_bias[0], np.zeros(3))

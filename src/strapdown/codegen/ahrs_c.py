@@ -142,7 +142,7 @@ def _epoch_constants(cfg: AhrsConfig, params: K.Params, prop: dict, h: float,
 
 
 def _constants(cfg: AhrsConfig, params: K.Params, prop: dict, h: float, mag: bool,
-               real: str) -> str:
+               real: str, n_init: int) -> str:
     """The .c file's constants: macros, the Params struct, tables, flags."""
     d = math.radians(cfg.declination_deg)
     lead = cfg.latency_s + (0.5 * h if cfg.gyro_sample == "interval" else 0.0)
@@ -156,6 +156,8 @@ def _constants(cfg: AhrsConfig, params: K.Params, prop: dict, h: float, mag: boo
               "NAN": "((NAME_real)NAN)",
               # a start in motion (filter._initial_covariance, filter._derived)
               "MOVING_SIGMA0_SQ": _lit(cfg.moving_start_sigma0 ** 2, real),
+              # a still start's gyro bias, measured over the window (filter._window_bias)
+              "WINDOW_BIAS_SIGMA0_SQ": _lit(F.window_bias_sigma(cfg, n_init, h) ** 2, real),
               "MOVING_MAG_S": _lit(cfg.moving_start_mag_s, real),
               "SETTLE_ALWAYS": str(int(cfg.acc_lowpass_settle)),
               "PROVISIONAL_S": _lit(K.PROVISIONAL_RECOVER_S, real),
@@ -242,7 +244,7 @@ def generate_ahrs(sample_rate_hz: float | None = None, *, h: float | None = None
     body = (_TEMPLATES / "ahrs.c.in").read_text()
     if real == "float":
         body = _to_float(body)
-    source = body.replace("@CONSTANTS@", _constants(cfg, params, prop, h, mag, real))
+    source = body.replace("@CONSTANTS@", _constants(cfg, params, prop, h, mag, real, n_init))
     return AhrsExport(name, _fill(header, name), _fill(source, name), real, h, mag,
                       algorithm, cfg, n_init)
 
