@@ -54,6 +54,29 @@ BROAD = _shared_dir("broad", "STRAPDOWN_BROAD")
 OPENAXES = _shared_dir("openaxes", "STRAPDOWN_OPENAXES") or Path("/nonexistent/openaxes")
 
 
+#: Tests that take what another module's run computed in this process (tests/shared_runs.py):
+#: each runs after that module's tests, in its pytest-xdist unit (so on the same worker).
+RUN_AFTER = {
+    "tests/ahrs/test_ahrs.py::test_broad_acceptance_against_fusion_and_vqf":
+        "tests/docs/test_docs_commands.py",  # the README's strapdown benchmark-ahrs
+    "tests/cli/test_cli.py::test_reproduce_plaksiy_writes_report":
+        "tests/docs/test_docs_commands.py",  # the README's strapdown reproduce plaksiy2024
+}
+
+
+def pytest_collection_modifyitems(session, config, items):
+    """Each test of :data:`RUN_AFTER` right after the last test of its module (the same
+    order on every worker: pytest-xdist checks that they collected the same list)."""
+    for nodeid, module in RUN_AFTER.items():
+        pos = next((i for i, it in enumerate(items) if it.nodeid == nodeid), None)
+        if pos is None:
+            continue
+        item = items.pop(pos)
+        last = max((i for i, it in enumerate(items)
+                    if it.nodeid.split("::", 1)[0] == module), default=None)
+        items.insert(pos if last is None else last + 1, item)
+
+
 _SHARED_FIXTURE = re.compile(r"""@pytest\.fixture\([^)]*scope\s*=\s*["'](?:module|class|package)""")
 #: A module that shares no fixture but an in-process cache its tests fill (a line
 #: ``ONE_WORKER = True`` with a comment saying which): on one worker it is filled once.
@@ -67,7 +90,8 @@ def pytest_xdist_make_scheduler(config, log):
     (a built site, a corpus of files, a documented session whose commands run in order) are
     one unit, so one worker builds it once, rather than every worker that gets one of them;
     so are the tests of a module that says ``ONE_WORKER = True`` (they fill a cache of the
-    process, e.g. tests/apps/test_advise.py).
+    process, e.g. tests/apps/test_advise.py), and a test of :data:`RUN_AFTER` joins the unit
+    of the module whose run it takes.
     Big units are handed out first. (``--dist loadgroup`` with ``xdist_group`` marks would
     say the same, but pytest 9.2 ignores the node-id suffix pytest-xdist 3.8 groups by.)"""
     if config.getvalue("dist") != "load":
@@ -79,6 +103,8 @@ def pytest_xdist_make_scheduler(config, log):
 
     class ModuleFixtureScheduling(LoadScopeScheduling):
         def _split_scope(self, nodeid: str) -> str:
+            if nodeid in RUN_AFTER:
+                return RUN_AFTER[nodeid]
             module = nodeid.split("::", 1)[0]
             if module not in shared:
                 try:

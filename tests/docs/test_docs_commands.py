@@ -34,6 +34,7 @@ import pytest
 
 from conftest import BROAD
 from inprocess import in_process_argvs, run_in_process
+from shared_runs import recording, succeeded
 
 REPO = Path(__file__).resolve().parents[2]
 LONG = os.environ.get("STRAPDOWN_DOCS_LONG") == "1"
@@ -142,7 +143,11 @@ class Session:
         argvs = in_process_argvs(line, self.env)
         if argvs is not None:  # no shell needed: the same argv, without a new interpreter
             t0 = time.perf_counter()
-            code, out, err = run_in_process(argvs, self.cwd, self.env)
+            with recording():  # what a test would compute again (tests/shared_runs.py)
+                code, out, err = run_in_process(argvs, self.cwd, self.env)
+            if code == 0:
+                for argv in argvs:
+                    succeeded(argv, self.cwd)
             return Result(code, out, err, time.perf_counter() - t0)
         state = self.root / ".cwd"
         script = f"cd {shlex.quote(str(self.cwd))} || exit 99\n{line}\nrc=$?\n" \
