@@ -8,6 +8,12 @@ DEMO_OUT ?= reports/li2017
 
 .PHONY: demo test bench lint fuzz clean docs
 
+# Python writes its bytecode caches (__pycache__/, ignored by git) even when the caller's
+# environment says not to (PYTHONDONTWRITEBYTECODE): the suite starts some hundred
+# interpreters, command lines and workers, that would each compile the package's source again
+# (~0.2 s each) and pytest would rewrite every test module in each worker.
+unexport PYTHONDONTWRITEBYTECODE
+
 $(PY):
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
@@ -27,9 +33,16 @@ demo: $(STAMP)
 
 ## test: install dev extras, lint (style, import layers, types), run the whole suite on every
 ## core (pytest-xdist; a module's tests that share its fixture run on one worker) and list the
-## slowest 20 tests
-test: lint
-	$(PY) -m pytest -q -n auto --durations=20
+## slowest 20 tests. make lint runs beside the suite (mostly mypy, single-threaded: it fills
+## the time a worker waits for the other's numba warm-up), its output printed after the
+## suite's; either one failing fails make test
+test: $(DEVSTAMP)
+	@$(MAKE) --no-print-directory lint > $(VENV)/lint.log 2>&1 & lint=$$!; \
+	$(PY) -m pytest -q -n auto --durations=20; suite=$$?; \
+	wait $$lint; linted=$$?; \
+	echo "make lint (run beside the suite):"; cat $(VENV)/lint.log; \
+	if [ $$linted -ne 0 ]; then echo "make lint failed (exit $$linted)"; exit 1; fi; \
+	exit $$suite
 
 ## fuzz: the long fuzz campaign — the corpus and >= 10^4 generated hostile files through every
 ## reader and every command that reads a file, under a memory cap and a time limit (counts per
