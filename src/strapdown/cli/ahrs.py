@@ -127,6 +127,10 @@ def run(args: argparse.Namespace) -> int:
         say(f"note: {what} units inferred from the data: {unit}")
     if not res.heading_observed:
         say("warning: no magnetometer: heading is not observed (gyro integral from yaw 0)")
+    if res.mag_offset is not None:
+        say("note: the magnetometer carries a hard-iron offset (a field fixed in the body); "
+            f"the offline filter subtracted {[round(float(x), 6) for x in res.mag_offset]} "
+            "(its unit; see AhrsConfig.offline_hard_iron_min_explained)")
     if not res.start_still:
         say("note: the recording starts in motion (its first "
             f"{cfg.init_window_s:g} s are not still): the first seconds converge from a "

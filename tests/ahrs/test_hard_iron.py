@@ -1,0 +1,131 @@
+"""The hard-iron offset from the gyro (:mod:`strapdown.ahrs.hard_iron`) and its use by
+:func:`strapdown.ahrs.offline_ekf`."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import strapdown.ahrs._kernel as K
+from strapdown.ahrs import AhrsConfig, offline_ekf
+from strapdown.ahrs.hard_iron import SPREAD_MAX, STEADIER_MAX, hard_iron
+from strapdown.rotation.dcm import dcm_from_quat
+from strapdown.rotation.error import attitude_error_angle
+from strapdown.rotation.quaternion import quat_multiply
+
+H = 0.01
+M_N = np.array([0.0, 20.0, -40.0])  # µT, ENU
+
+
+def _turning(n, axes=(1.0, 1.0, 1.0)):
+    """Interval gyro samples of a body turning about three axes (or those of ``axes`` not
+    zero), the attitude they give exactly (the gyro path itself) and the ideal field."""
+    t = np.arange(n) * H
+    w = np.column_stack([axes[0] * 1.2 * np.sin(1.3 * t), axes[1] * 0.9 * np.cos(0.7 * t),
+                         axes[2] * 0.8 * np.sin(2.1 * t + 0.4)])
+    q = np.empty((n, 4))
+    K.gyro_path(w, np.zeros((n, 3)), H, True, q)
+    m = np.einsum("nji,j->ni", dcm_from_quat(q), M_N)
+    return t, w, q, m
+
+
+def test_an_offset_is_recovered_whatever_the_unit():
+    """Exact samples: the offset to 1e-9 of the field, all of the residual explained, the
+    halves in agreement; the field's unit scales the offset and nothing else."""
+    t, w, _, m = _turning(3000)
+    b = np.array([9.0, -14.0, 6.0])
+    est = hard_iron(t, w, m + b)
+    assert est.observed == 3
+    assert np.allclose(est.offset, b, rtol=0, atol=1e-9 * np.linalg.norm(M_N))
+    assert est.explained == pytest.approx(1.0, abs=1e-12) and est.spread < 1e-9
+    assert est.steadier < 1e-6  # |m − b| is the Earth field's norm, constant
+    scaled = hard_iron(t, w, 1000.0 * (m + b))
+    assert np.allclose(scaled.offset, 1000.0 * b, rtol=1e-9, atol=0)
+    assert scaled.explained == pytest.approx(est.explained, abs=1e-12)
+
+
+def test_a_single_axis_turn_leaves_its_axis_unobserved():
+    """About one body axis only (a pendulum): ``I − R`` never sees the offset along it;
+    that component is left at zero and the other two are recovered."""
+    t, w, _, m = _turning(3000, axes=(1.0, 0.0, 0.0))
+    b = np.array([9.0, -14.0, 6.0])
+    est = hard_iron(t, w, m + b)
+    assert est.observed == 2
+    assert est.offset[0] == pytest.approx(0.0, abs=1e-9)
+    assert np.allclose(est.offset[1:], b[1:], rtol=0, atol=1e-6)
+
+
+def test_a_calibrated_field_explains_nothing():
+    rng = np.random.default_rng(2)
+    t, w, _, m = _turning(3000)
+    est = hard_iron(t, w, m + rng.normal(0.0, 0.3, m.shape))
+    assert est.explained < 0.01 and est.steadier > STEADIER_MAX
+
+
+def test_offline_filter_subtracts_a_constant_offset_only():
+    """A 30 µT offset (two thirds of the field): offline_ekf subtracts the estimate and its
+    attitude error falls; an offset present in the first half only (a magnet taken off) is
+    not a hard iron (the halves disagree) and is left; so is a calibrated field."""
+    n = 4000
+    t, w, q, m = _turning(n)
+    rng = np.random.default_rng(7)
+    acc = np.einsum("nji,j->ni", dcm_from_quat(q), [0.0, 0.0, 9.80665])
+    acc += rng.normal(0.0, 0.02, acc.shape)
+    m = m + rng.normal(0.0, 0.3, m.shape)
+    b = np.array([18.0, -20.0, 12.0])
+    r = offline_ekf(t, w, acc, m + b, q0=q[0])
+    off = offline_ekf(t, w, acc, m + b, q0=q[0],
+                      config=AhrsConfig(offline_hard_iron_min_explained=2.0))
+    assert r.mag_offset is not None and off.mag_offset is None
+    assert np.allclose(r.mag_offset, b, rtol=0, atol=0.5)
+    e_r, e_off = (np.sqrt(np.mean(attitude_error_angle(x.q, q) ** 2)) for x in (r, off))
+    assert e_r < 0.5 * e_off
+    half = m + np.where(np.arange(n)[:, None] < n // 2, b, 0.0)
+    est = hard_iron(t, w, half)
+    assert est.spread > SPREAD_MAX
+    assert offline_ekf(t, w, acc, half, q0=q[0]).mag_offset is None
+    assert offline_ekf(t, w, acc, m, q0=q[0]).mag_offset is None
+
+
+def test_bad_input_names_the_problem():
+    t, w, _, m = _turning(50)
+    with pytest.raises(ValueError, match="gyro and mag"):
+        hard_iron(t, w[:, :2], m)
+    with pytest.raises(ValueError, match="finite"):
+        hard_iron(t, w, np.where(np.arange(50)[:, None] == 3, np.nan, m))
+    with pytest.raises(ValueError, match="fewer than two spans"):
+        hard_iron(t[:11], w[:11], m[:11], span_s=0.1)
+
+
+def test_quat_multiply_is_the_convention_used():
+    """The gyro path composes body-frame increments on the right (q ⊗ δq), as the
+    spans' ``R = D_{k+d}ᵀ D_k`` assumes."""
+    _, w, q, _ = _turning(3)
+    step = np.empty((2, 4))
+    K.gyro_path(w[1:], np.zeros((2, 3)), H, True, step)
+    assert np.allclose(quat_multiply(q[1], step[1]), q[2], atol=1e-15)
+
+
+def test_cli_offline_says_what_it_subtracted(tmp_path, capsys):
+    """``strapdown ahrs --offline`` on a field with a hard iron: a note on stderr and the
+    offset in the metadata; the causal run subtracts nothing."""
+    import json
+
+    from strapdown.cli import main
+
+    n = 3000
+    t, w, q, m = _turning(n)
+    acc = np.einsum("nji,j->ni", dcm_from_quat(q), [0.0, 0.0, 9.80665])
+    b = np.array([18.0, -20.0, 12.0])
+    np.savetxt(tmp_path / "imu.csv", np.column_stack([t, w, acc, m + b]), delimiter=",",
+               header="t,gx,gy,gz,ax,ay,az,mx,my,mz", comments="")
+    base = ["ahrs", "--imu", str(tmp_path / "imu.csv"), "--gyro-units", "rad/s",
+            "--acc-units", "m/s2"]
+    assert main([*base, "--offline", "--out", str(tmp_path / "off.csv")]) == 0
+    assert "hard-iron offset" in capsys.readouterr().err
+    meta = json.loads((tmp_path / "off.csv.meta.json").read_text())
+    assert np.allclose(meta["mag_hard_iron_subtracted"], b, atol=1e-6)
+    assert main([*base, "--out", str(tmp_path / "causal.csv")]) == 0
+    assert "hard-iron" not in capsys.readouterr().err
+    assert json.loads((tmp_path / "causal.csv.meta.json").read_text())[
+        "mag_hard_iron_subtracted"] is None
