@@ -1152,7 +1152,10 @@ def offline_ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
     low-pass lag of one pass cancels the lead of the other, and the first seconds,
     where the forward filter is still converging, get the backward estimate; last, what
     of the combination varies faster than ``offline_smooth_s`` about the bias-corrected
-    gyro's own path is removed (zero-phase; :class:`AhrsConfig`). Arguments
+    gyro's own path is removed (zero-phase; :class:`AhrsConfig`). Before the passes, a
+    hard-iron offset of the magnetometer found from the gyro over the whole record is
+    subtracted when the tests of ``offline_hard_iron_min_explained`` pass
+    (:mod:`strapdown.ahrs.hard_iron`; ``AhrsResult.mag_offset``). Arguments
     as for :func:`ekf`; the result has ``smoothed`` set, its flags, NIS and
     manoeuvre acceleration are the forward pass's.
 
