@@ -54,26 +54,34 @@ BROAD = _shared_dir("broad", "STRAPDOWN_BROAD")
 OPENAXES = _shared_dir("openaxes", "STRAPDOWN_OPENAXES") or Path("/nonexistent/openaxes")
 
 
-#: Tests that take what another module's run computed in this process (tests/shared_runs.py):
-#: each runs after that module's tests, in its pytest-xdist unit (so on the same worker).
+#: Tests that take what another module's tests computed in this process: each runs after
+#: that module's tests (or right after the one test named), in its pytest-xdist unit (so on
+#: the same worker).
 RUN_AFTER = {
+    # tests/shared_runs.py: the README's strapdown benchmark-ahrs and reproduce plaksiy2024
     "tests/ahrs/test_ahrs.py::test_broad_acceptance_against_fusion_and_vqf":
-        "tests/docs/test_docs_commands.py",  # the README's strapdown benchmark-ahrs
+        "tests/docs/test_docs_commands.py",
     "tests/cli/test_cli.py::test_reproduce_plaksiy_writes_report":
-        "tests/docs/test_docs_commands.py",  # the README's strapdown reproduce plaksiy2024
+        "tests/docs/test_docs_commands.py",
+    # the report's strapdown advise on a 400 Hz log: the K(ω) of those bins (mpmath, cached in
+    # the process) computed by test_advise's 400 Hz tests, before its 1 kHz ones evict them
+    "tests/reproduce/test_high_order.py::test_full_report":
+        "tests/apps/test_advise.py::test_verified_recommendation_meets_the_budget_against_truth",
 }
 
 
 def pytest_collection_modifyitems(session, config, items):
-    """Each test of :data:`RUN_AFTER` right after the last test of its module (the same
-    order on every worker: pytest-xdist checks that they collected the same list)."""
-    for nodeid, module in RUN_AFTER.items():
+    """Each test of :data:`RUN_AFTER` right after the last test of its module, or the test
+    it names (the same order on every worker: pytest-xdist checks that they collected the
+    same list)."""
+    for nodeid, after in RUN_AFTER.items():
         pos = next((i for i, it in enumerate(items) if it.nodeid == nodeid), None)
         if pos is None:
             continue
         item = items.pop(pos)
         last = max((i for i, it in enumerate(items)
-                    if it.nodeid.split("::", 1)[0] == module), default=None)
+                    if it.nodeid == after or it.nodeid.split("::", 1)[0] == after),
+                   default=None)
         items.insert(pos if last is None else last + 1, item)
 
 
@@ -104,7 +112,7 @@ def pytest_xdist_make_scheduler(config, log):
     class ModuleFixtureScheduling(LoadScopeScheduling):
         def _split_scope(self, nodeid: str) -> str:
             if nodeid in RUN_AFTER:
-                return RUN_AFTER[nodeid]
+                return RUN_AFTER[nodeid].split("::", 1)[0]
             module = nodeid.split("::", 1)[0]
             if module not in shared:
                 try:
