@@ -129,3 +129,24 @@ def test_cli_offline_says_what_it_subtracted(tmp_path, capsys):
     assert "hard-iron" not in capsys.readouterr().err
     assert json.loads((tmp_path / "causal.csv.meta.json").read_text())[
         "mag_hard_iron_subtracted"] is None
+
+
+def test_the_compiled_sums_equal_a_plain_numpy_reference():
+    """``_kernel.hard_iron_sums`` against the spans written with numpy (``R = D_{k+d}ᵀ D_k``,
+    ``A = I − R``, ``r = m_{k+d} − R m_k``) and against its own plain Python."""
+    rng = np.random.default_rng(4)
+    _, _, q, m = _turning(600)
+    m = m + rng.normal(0.0, 0.3, m.shape) + [5.0, -3.0, 2.0]
+    d, lo, hi = 7, 11, 590
+    i = np.arange(lo, hi)
+    r_ = np.einsum("nji,njk->nik", dcm_from_quat(q[i + d]), dcm_from_quat(q[i]))
+    a = np.eye(3) - r_
+    r = m[i + d] - np.einsum("nij,nj->ni", r_, m[i])
+    normal, rhs = np.zeros((3, 3)), np.zeros(3)
+    rr = K.hard_iron_sums(q, m, d, lo, hi, normal, rhs)
+    assert rr == pytest.approx(float(np.sum(r * r)), rel=1e-12)
+    assert np.allclose(normal, np.einsum("nji,njk->ik", a, a), rtol=1e-12, atol=1e-12)
+    assert np.allclose(rhs, np.einsum("nji,nj->i", a, r), rtol=1e-12, atol=1e-10)
+    n2, r2 = np.zeros((3, 3)), np.zeros(3)
+    assert K.hard_iron_sums.py_func(q, m, d, lo, hi, n2, r2) == pytest.approx(rr, rel=1e-14)
+    assert np.allclose(n2, normal, rtol=1e-14, atol=0) and np.allclose(r2, rhs, rtol=1e-13)

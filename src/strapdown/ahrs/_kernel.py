@@ -1476,3 +1476,32 @@ def gyro_path(omega, bias, td, interval, out):
         out[k, 1] = qx * r
         out[k, 2] = qy * r
         out[k, 3] = qz * r
+
+
+@njit(cache=True, error_model="numpy")
+def hard_iron_sums(q, m, d, lo, hi, normal, rhs):
+    """The hard-iron estimate's sums over the spans starting at samples ``lo … hi − 1``
+    (:mod:`strapdown.ahrs.hard_iron`): with ``R = D_{k+d}ᵀ D_k`` (``D`` = C_n_b of ``q``),
+    ``A = I − R`` and ``r = m_{k+d} − R m_k``, adds ``AᵀA`` to ``normal`` and ``Aᵀr`` to
+    ``rhs``; returns ``Σ |r|²``."""
+    d0 = np.empty((3, 3))
+    d1 = np.empty((3, 3))
+    a = np.empty((3, 3))
+    r = np.empty(3)
+    rr = 0.0
+    for k in range(lo, hi):
+        _dcm(q[k], d0)
+        _dcm(q[k + d], d1)
+        for i in range(3):
+            for j in range(3):
+                a[i, j] = -(d1[0, i] * d0[0, j] + d1[1, i] * d0[1, j] + d1[2, i] * d0[2, j])
+            a[i, i] += 1.0
+        for i in range(3):  # r = m_{k+d} − R m_k = m_{k+d} − m_k + A m_k
+            r[i] = (m[k + d, i] - m[k, i] + a[i, 0] * m[k, 0] + a[i, 1] * m[k, 1]
+                    + a[i, 2] * m[k, 2])
+            rr += r[i] * r[i]
+        for i in range(3):
+            rhs[i] += a[0, i] * r[0] + a[1, i] * r[1] + a[2, i] * r[2]
+            for j in range(3):
+                normal[i, j] += a[0, i] * a[0, j] + a[1, i] * a[1, j] + a[2, i] * a[2, j]
+    return rr

@@ -37,12 +37,9 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from strapdown.ahrs import _kernel as K
-from strapdown.rotation.dcm import dcm_from_quat
 
-__all__ = ["CHUNK", "SPREAD_MAX", "STEADIER_MAX", "HardIron", "hard_iron"]
+__all__ = ["SPREAD_MAX", "STEADIER_MAX", "HardIron", "hard_iron"]
 
-#: Spans processed at once (bounds the memory: a few hundred bytes per span).
-CHUNK = 1 << 18
 #: A hard iron is constant: the two halves' offsets may differ by at most this fraction of
 #: the whole record's (simulated offsets: ≤ 0.04; BROAD's 2 cm magnet, attached for part of
 #: the trial: 1.43, its halves explaining 85 % and 6 %).
@@ -136,14 +133,8 @@ def hard_iron(t: ArrayLike, gyro: ArrayLike, mag: ArrayLike, *, span_s: float = 
     K.gyro_path(w, np.zeros((n, 3)), h, gyro_sample == "interval", q)
     half = (n - d) // 2
     normal, rhs = np.zeros((2, 3, 3)), np.zeros((2, 3))  # per half: Σ AᵀA, Σ Aᵀr
-    rr = 0.0
-    for j, (lo, hi) in enumerate(((0, half), (half, n - d))):
-        for i0 in range(lo, hi, CHUNK):
-            i = np.arange(i0, min(hi, i0 + CHUNK))
-            a, r = _spans(q, m, i, d)
-            normal[j] += np.einsum("nji,njk->ik", a, a)
-            rhs[j] += np.einsum("nji,nj->i", a, r)
-            rr += float(np.sum(r * r))
+    rr = sum(K.hard_iron_sums(q, m, d, lo, hi, normal[j], rhs[j])
+             for j, (lo, hi) in enumerate(((0, half), (half, n - d))))
     n_all, r_all = normal.sum(axis=0), rhs.sum(axis=0)
     lam, vec = np.linalg.eigh(n_all)
     keep = lam >= min_eigen * lam[-1] if lam[-1] > 0 else np.zeros(3, bool)
@@ -165,11 +156,3 @@ def _cv(m) -> float:
     n = np.linalg.norm(m, axis=1)
     mean = float(n.mean())
     return float(n.std()) / mean if mean > 0 else 0.0
-
-
-def _spans(q, m, i, d):
-    """``(I − R, m_{k+d} − R m_k)`` for the spans starting at samples ``i``:
-    ``R = D_{k+d}ᵀ D_k``, ``D`` the gyro path's body-to-reference rotation."""
-    d0, d1 = dcm_from_quat(q[i]), dcm_from_quat(q[i + d])
-    r = np.einsum("nji,njk->nik", d1, d0)
-    return np.eye(3) - r, m[i + d] - np.einsum("nij,nj->ni", r, m[i])
