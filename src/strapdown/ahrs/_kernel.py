@@ -1442,40 +1442,22 @@ def predict(q, omega, bias, lead, out):
 def gyro_path(omega, bias, td, interval, out):
     """The attitude the bias-corrected gyro alone gives, from the identity at row 0:
     ``out[k] = out[k−1] ⊗ q(φ_k)``, with ``φ_k = td (ω_k − b_k)`` for interval samples (the
-    mean rate over the period that ends at sample k) and rate-single's
-    ``td/2 (w₀ + w₁) + td²/6 w₀ × w₁`` (``w = ω − b_k`` at samples k − 1 and k) for point
-    samples; each row normalised."""
+    mean rate over the period that ends at sample k) and, for point samples, rate-single's
+    single-period step on ``ω − b_k`` at samples k − 1 and k (:func:`_startup_step`, pair
+    coefficient 1/6); each row normalised (:func:`_update`)."""
     out[0, 0] = 1.0
     for i in range(1, 4):
         out[0, i] = 0.0
-    eps = np.empty(3)
+    phi = np.empty(3)
+    tmp = np.empty(4)
     for k in range(1, out.shape[0]):
         if interval:
             for a in range(3):
-                eps[a] = td * (omega[k, a] - bias[k, a])
+                phi[a] = td * (omega[k, a] - bias[k, a])
+            _update(out[k - 1], phi, out[k])
         else:
-            u0 = omega[k - 1, 0] - bias[k, 0]
-            u1 = omega[k - 1, 1] - bias[k, 1]
-            u2 = omega[k - 1, 2] - bias[k, 2]
-            v0 = omega[k, 0] - bias[k, 0]
-            v1 = omega[k, 1] - bias[k, 1]
-            v2 = omega[k, 2] - bias[k, 2]
-            c = td * td / 6.0
-            eps[0] = 0.5 * td * (u0 + v0) + c * (u1 * v2 - u2 * v1)
-            eps[1] = 0.5 * td * (u1 + v1) + c * (u2 * v0 - u0 * v2)
-            eps[2] = 0.5 * td * (u2 + v2) + c * (u0 * v1 - u1 * v0)
-        dw, s = _small_rotation(eps)
-        ex, ey, ez = s * eps[0], s * eps[1], s * eps[2]
-        w0, x0, y0, z0 = out[k - 1, 0], out[k - 1, 1], out[k - 1, 2], out[k - 1, 3]
-        qw = w0 * dw - x0 * ex - y0 * ey - z0 * ez
-        qx = w0 * ex + x0 * dw + y0 * ez - z0 * ey
-        qy = w0 * ey - x0 * ez + y0 * dw + z0 * ex
-        qz = w0 * ez + x0 * ey - y0 * ex + z0 * dw
-        r = 1.0 / np.sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
-        out[k, 0] = qw * r
-        out[k, 1] = qx * r
-        out[k, 2] = qy * r
-        out[k, 3] = qz * r
+            out[k, :] = out[k - 1, :]
+            _startup_step(k, omega, td, 1.0 / 6.0, out[k], bias[k], phi, tmp)
 
 
 @njit(cache=True, error_model="numpy")
