@@ -1115,13 +1115,15 @@ def _gyro_smooth(rec, out: K.Outputs, cfg: AhrsConfig) -> None:
     or the cut-off above half the sample rate."""
     from scipy.signal import butter, sosfiltfilt
 
+    from strapdown.rotation.quaternion import quat_conjugate
+
     tau, n = cfg.offline_smooth_s, rec.t.size
     fc = math.sqrt(2.0) / (2.0 * math.pi * tau) if tau > 0 else math.inf
     if not fc < 0.5 / rec.td or n <= _SMOOTH_PAD:
         return
     q_g = np.empty_like(out.q)
     K.gyro_path(rec.omega, out.gyro_bias, float(rec.td), cfg.gyro_sample == "interval", q_g)
-    c = quat_multiply(out.q, q_g * np.array([1.0, -1.0, -1.0, -1.0]))
+    c = quat_multiply(out.q, quat_conjugate(q_g))
     flip = np.einsum("ij,ij->i", c[1:], c[:-1]) < 0
     c[1:] *= np.where(np.logical_xor.accumulate(flip), -1.0, 1.0)[:, None]
     c = sosfiltfilt(butter(2, fc, fs=1.0 / rec.td, output="sos"), c, axis=0,
