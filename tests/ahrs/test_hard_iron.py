@@ -89,9 +89,13 @@ def test_offline_filter_subtracts_a_constant_offset_only():
 
 def test_bad_input_names_the_problem():
     t, w, _, m = _turning(50)
-    with pytest.raises(ValueError, match="gyro and mag"):
+    with pytest.raises(ValueError, match=r"rates must have shape \(50, 3\)"):
         hard_iron(t, w[:, :2], m)
-    with pytest.raises(ValueError, match="finite"):
+    with pytest.raises(ValueError, match=r"mag must have shape \(50, 3\)"):
+        hard_iron(t, w, m[:, :2])
+    with pytest.raises(ValueError, match="non-monotonic time stamp at row 1"):
+        hard_iron(t[::-1], w, m)
+    with pytest.raises(ValueError, match="mag contains NaN or infinity"):
         hard_iron(t, w, np.where(np.arange(50)[:, None] == 3, np.nan, m))
     with pytest.raises(ValueError, match="fewer than two spans"):
         hard_iron(t[:11], w[:11], m[:11], span_s=0.1)

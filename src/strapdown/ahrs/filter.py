@@ -947,6 +947,12 @@ def _setup(t, gyro, acc, mag, cfg: AhrsConfig, q0, gyro_bias0, mag_reference, fr
     """Validated record and initial state: (rec, acc, mag, have_mag, q_init (ENU), b0,
     reference field (norm, dip, heading), :class:`_Start`)."""
     rec, acc, mag, have_mag = _validate(t, gyro, acc, mag, cfg, frame)
+    return _prepare(rec, acc, mag, have_mag, cfg, q0, gyro_bias0, mag_reference, frame)
+
+
+def _prepare(rec, acc, mag, have_mag: bool, cfg: AhrsConfig, q0, gyro_bias0, mag_reference,
+             frame):
+    """:func:`_setup` on a record :func:`_validate` has checked."""
     start = _start(rec, acc, cfg, q0, mag_reference)
     q_init, m0 = _initial_attitude(rec, acc, mag, have_mag, cfg, q0, frame, start.still)
     ref = (_reference_field(rec, mag, q_init, m0, q0, mag_reference, cfg) if have_mag
@@ -1167,11 +1173,13 @@ def offline_ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
         On invalid input, naming the problem.
     """
     cfg = config or AhrsConfig()
-    offset = _hard_iron_offset(t, gyro, acc, mag, cfg, frame)
+    rec, acc, mag, have_mag = _validate(t, gyro, acc, mag, cfg, frame)
+    offset = _hard_iron_offset(rec, mag, have_mag, cfg)
     if offset is not None:
-        mag = np.asarray(mag, dtype=np.float64) - offset
-    rec, acc, mag, have_mag, q_init, b0, ref, start = _setup(t, gyro, acc, mag, cfg, q0,
-                                                              gyro_bias0, mag_reference, frame)
+        mag = mag - offset
+    rec, acc, mag, have_mag, q_init, b0, ref, start = _prepare(rec, acc, mag, have_mag, cfg,
+                                                                q0, gyro_bias0, mag_reference,
+                                                                frame)
     cfg_pass = replace(cfg, heading_rate_noise=cfg.offline_heading_rate_noise)
     fwd, epoch, gravity = _filter(rec, acc, mag, have_mag, cfg_pass, algorithm, q_init, b0,
                                   ref, start, True)
@@ -1183,7 +1191,7 @@ def offline_ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
                            smoothed=True), mag_offset=offset)
 
 
-def _hard_iron_offset(t, gyro, acc, mag, cfg: AhrsConfig, frame: str) -> np.ndarray | None:
+def _hard_iron_offset(rec, mag, have_mag: bool, cfg: AhrsConfig) -> np.ndarray | None:
     """The field's hard-iron offset to subtract before :func:`offline_ekf`'s passes
     (:func:`strapdown.ahrs.hard_iron.hard_iron` on the validated record), or None: no
     field, too short a record, an offset that explains less than
@@ -1191,13 +1199,12 @@ def _hard_iron_offset(t, gyro, acc, mag, cfg: AhrsConfig, frame: str) -> np.ndar
     :data:`~strapdown.ahrs.hard_iron.SPREAD_MAX`: not constant, so not a hard iron) or one
     whose removal hardly steadies the field's norm (above
     :data:`~strapdown.ahrs.hard_iron.STEADIER_MAX`)."""
-    from strapdown.ahrs.hard_iron import SPREAD_MAX, STEADIER_MAX, hard_iron
+    from strapdown.ahrs.hard_iron import SPREAD_MAX, STEADIER_MAX, _hard_iron
 
-    rec, _, m, have_mag = _validate(t, gyro, acc, mag, cfg, frame)
     if not have_mag or cfg.offline_hard_iron_min_explained > 1:
         return None
     try:
-        est = hard_iron(rec.t, rec.omega, m, gyro_sample=cfg.gyro_sample)
+        est = _hard_iron(rec.omega, mag, rec.td, gyro_sample=cfg.gyro_sample)
     except ValueError:  # fewer than two spans: nothing to learn from
         return None
     ok = (est.explained >= cfg.offline_hard_iron_min_explained and est.spread <= SPREAD_MAX

@@ -36,7 +36,9 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from strapdown._core.validation import finite_array
 from strapdown.ahrs import _kernel as K
+from strapdown.algorithms.rate import check_rate_record
 
 __all__ = ["SPREAD_MAX", "STEADIER_MAX", "HardIron", "hard_iron"]
 
@@ -87,7 +89,8 @@ def hard_iron(t: ArrayLike, gyro: ArrayLike, mag: ArrayLike, *, span_s: float = 
     Parameters
     ----------
     t : array_like (n,)
-        Sample times, s, uniform (the median period is used).
+        Sample times, s, uniform (as :func:`strapdown.algorithms.rate.check_rate_record`
+        takes them).
     gyro : array_like (n, 3)
         Body rates, rad/s (as in :func:`strapdown.ahrs.ekf`; a bias of a degree per second
         turns a 0.1 s span by 0.1°, negligible here).
@@ -109,28 +112,32 @@ def hard_iron(t: ArrayLike, gyro: ArrayLike, mag: ArrayLike, *, span_s: float = 
     Raises
     ------
     ValueError
-        On mismatched shapes, fewer than two spans, or non-finite input.
+        On invalid time stamps or rates (:func:`~strapdown.algorithms.rate.check_rate_record`
+        names the row), a field of another shape or not finite, a non-positive ``span_s``,
+        ``min_eigen`` outside (0, 1], or fewer than two spans.
     """
-    t = np.asarray(t, dtype=np.float64)
-    w = np.ascontiguousarray(gyro, dtype=np.float64)
-    m = np.ascontiguousarray(mag, dtype=np.float64)
-    n = t.size
-    if t.ndim != 1 or w.shape != (n, 3) or m.shape != (n, 3):
-        raise ValueError(f"t must be (n,), gyro and mag (n, 3); got {t.shape}, {w.shape}, "
-                         f"{m.shape}")
-    if not (np.isfinite(t).all() and np.isfinite(w).all() and np.isfinite(m).all()):
-        raise ValueError("t, gyro and mag must be finite")
-    if n < 3:
-        raise ValueError(f"need at least 3 samples, got {n}")
-    h = float(np.median(np.diff(t)))
-    if not h > 0 or not span_s > 0 or not 0 < min_eigen <= 1:
-        raise ValueError(f"need a positive sample period and span_s, 0 < min_eigen <= 1; got "
-                         f"{h}, {span_s}, {min_eigen}")
-    d = max(1, round(span_s / h))
+    rec = check_rate_record(t, gyro, min_samples=3)
+    n = rec.t.size
+    m = finite_array(mag, "mag")
+    if m.shape != (n, 3):
+        raise ValueError(f"mag must have shape ({n}, 3) to match t, got {m.shape}")
+    if not span_s > 0 or not 0 < min_eigen <= 1:
+        raise ValueError(f"need span_s > 0 and 0 < min_eigen <= 1; got {span_s}, {min_eigen}")
+    return _hard_iron(rec.omega, m, rec.td, span_s, min_eigen, gyro_sample)
+
+
+def _hard_iron(omega, m, td: float, span_s: float = 0.1, min_eigen: float = 0.05,
+               gyro_sample: str = "interval") -> HardIron:
+    """:func:`hard_iron` on a validated record: rates and field (n, 3), uniform period
+    ``td``."""
+    n = m.shape[0]
+    d = max(1, round(span_s / td))
     if n - d < 2:
         raise ValueError(f"the record ({n} samples) holds fewer than two spans of {d}")
+    m = np.ascontiguousarray(m, dtype=np.float64)
     q = np.empty((n, 4))
-    K.gyro_path(w, np.zeros((n, 3)), h, gyro_sample == "interval", q)
+    K.gyro_path(np.ascontiguousarray(omega, dtype=np.float64), np.zeros((n, 3)), float(td),
+                gyro_sample == "interval", q)
     half = (n - d) // 2
     normal, rhs = np.zeros((2, 3, 3)), np.zeros((2, 3))  # per half: Σ AᵀA, Σ Aᵀr
     rr = sum(K.hard_iron_sums(q, m, d, lo, hi, normal[j], rhs[j])
