@@ -66,11 +66,8 @@ def in_process_argvs(line: str, env: dict[str, str]) -> list[list[str]] | None:
             return None
         if not words:
             return None
-        if words[0] == "strapdown":
-            pass
-        elif words[0] == "python" and len(words) > 1 and words[1].endswith(".py"):
-            pass
-        else:
+        script = words[0] == "python" and len(words) > 1 and words[1].endswith(".py")
+        if words[0] != "strapdown" and not script:
             return None
         expanded = [_expand(w, env) for w in words]
         if any(w is None for w in expanded):

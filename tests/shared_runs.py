@@ -64,11 +64,13 @@ def succeeded(argv: list[str], cwd: Path) -> None:
 def broad_benchmark(directory: Path, out: Path) -> tuple[dict, Path]:
     """``benchmark(directory, out)`` with its defaults (rate-single, BROAD's metric): the
     results and the report's directory, the documented command's if this process ran it."""
-    key = (str(Path(directory).resolve()), "rate-single", False)
-    if key in _BROAD:
-        return _BROAD[key]
     from strapdown.apps.ahrs_benchmark import benchmark
 
+    default = inspect.signature(benchmark).parameters
+    key = (str(Path(directory).resolve()), default["algorithm"].default,
+           bool(default["heading_offset_removed"].default))
+    if key in _BROAD:
+        return _BROAD[key]
     return benchmark(directory, out), out
 
 
