@@ -544,12 +544,12 @@ def test_heading_model_jacobian_and_innovation(k):
     dx = np.array([1e-3, -2e-3, 3e-3, 0.5, 0.5, 0.5])
     truth = _q([0.01, -0.02, 0.03])
     mn = C_HAT @ dcm_from_quat(quat_multiply(Q_HAT, truth)).T @ M_REF
-    k._heading_model(p, C_HAT, M_REF.copy(), np.zeros(6), H, y)
+    k._heading_model(p.ref_heading, C_HAT, M_REF.copy(), np.zeros(6), H, y)
     fd = _fd_jacobian(_heading_of, 3)
     assert np.allclose(H[:, :3], fd, rtol=0, atol=1e-9)
     assert np.all(H[:, 3:] == 0) and abs(y[0]) < 1e-14
     assert np.linalg.norm(H[0, :3] + C_HAT[2]) > 1.0  # the dip's tilt rows are there
-    k._heading_model(p, C_HAT, mn, dx, H, y)
+    k._heading_model(p.ref_heading, C_HAT, mn, dx, H, y)
     assert y[0] == pytest.approx(math.atan2(mn[1], mn[0]) - REF[2] - H[0] @ dx, abs=1e-15)
 
 
@@ -559,7 +559,7 @@ def test_heading_innovation_is_wrapped(k):
     for ref, head, expect in ((-179.0, 179.0, -2.0), (179.0, -179.0, 2.0)):
         p = _params_of()._replace(ref_heading=math.radians(ref))
         mn = np.array([math.cos(math.radians(head)), math.sin(math.radians(head)), -1.0])
-        k._heading_model(p, np.eye(3), mn, np.zeros(6), H, y)
+        k._heading_model(p.ref_heading, np.eye(3), mn, np.zeros(6), H, y)
         assert math.degrees(y[0]) == pytest.approx(expect, abs=1e-12)
 
 
@@ -734,7 +734,9 @@ def test_delay_estimator_finds_the_magnetometer_lag(k, delay):
     m = np.einsum("nji,j->ni", dcm_from_quat(q), M_REF)
     mag = np.vstack([np.repeat(m[:1], delay, 0), m[:n - delay]])
     res = np.zeros(6)
-    last, seen = k._fold_delay_samples(0, n - 1, 0, w, mag, h, True, np.zeros(3), 0.01, res)
+    no_offset = np.zeros((7, 3))  # the online hard-iron state: no offset applied
+    last, seen = k._fold_delay_samples(0, n - 1, 0, w, mag, no_offset, h, True, np.zeros(3),
+                                       0.01, res)
     assert (last, seen) == (n - 1, n - 1 - 6)
     assert int(np.argmin(res)) == delay
     assert np.sort(res)[1] > 10 * res.min()

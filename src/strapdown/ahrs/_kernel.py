@@ -80,11 +80,21 @@ F_REST = int(MeasurementFlag.REST)
 F_ACC_RECOVERED = int(MeasurementFlag.ACC_RECOVERED)
 F_MAG_RECOVERED = int(MeasurementFlag.MAG_RECOVERED)
 F_ACC_DISTURBED = int(MeasurementFlag.ACC_DISTURBED)
+F_MAG_OFFSET = int(MeasurementFlag.MAG_OFFSET)
 
 # the magnetometer's disturbance state (a float array the stages share, see
 # _mag_disturbance): reference norm and dip, time undisturbed, disturbed (0/1), candidate
 # norm, dip and time, time rejected
 M_NORM, M_DIP, M_UNDIST, M_DIST, M_CNORM, M_CDIP, M_CT, M_REJECT = range(8)
+# the online hard-iron estimate (:func:`_hard_iron_span`), its sums forgetting: scalars —
+# Σ|r|², Σ 1, Σ|m|², Σ|m|⁴, when its tests began to hold (−1: not holding), epochs since the
+# last span, whether a previous span end is stored (0/1) —, vectors — Σ Aᵀr, the estimate
+# b, the offset applied, b when the tests began to hold, the previous span end's field
+# (body), Σ m, Σ |m|² m — and matrices — Σ AᵀA, the previous span end's gyro-path C_n_b,
+# Σ m mᵀ
+H_RR, H_W, H_Q, H_QQ, H_HOLD, H_EPOCHS, H_PREV = range(7)
+V_Y, V_B, V_APP, V_HOLD, V_PREV, V_M, V_QM = range(7)
+X_N, X_PREV, X_MM = range(3)
 #: The slow mean of the low-passed specific force (:func:`_motion_power`) has this many
 #: times the low-pass's time constant.
 MOTION_SLOW = 4.0
@@ -210,6 +220,16 @@ class Params(NamedTuple):
     heading_bridge_noise: bool  #: AhrsConfig.heading_bridge_noise
     meas_lead: float  #: how far the magnetometer's samples lead the attitude they update, s
     #: (half a period for point field samples beside interval gyro samples; :func:`_at_state_time`)
+    hi_on: bool  #: estimate a hard iron online (:func:`_hard_iron_span`)
+    hi_span: int  #: its span, epochs
+    hi_forget: float  #: its sums' forgetting factor per span
+    hi_ridge: float  #: its ridge, a fraction of the trace of Σ AᵀA
+    hi_min_explained: float  #: its tests: the fraction of Σ|r|² the estimate explains,
+    hi_steadier: float  #: the norm's steadying (coefficient of variation, corrected / raw),
+    hi_spread: float  #: the estimate's drift while they hold (a fraction of |b|),
+    hi_update: float  #: how far it moves (a fraction of |b|) before it is applied again,
+    hi_hold_s: float  #: how long they must hold, s,
+    hi_min_spans: float  #: and the sums' weight (spans) they need
 
 
 class Initial(NamedTuple):
@@ -866,13 +886,14 @@ def _acc_raw_model(params, accel, C, fk, v, dx, H, y):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _fold_delay_samples(last, k, n_seen, x, mag, h, is_rate, bias, alpha, res):
+def _fold_delay_samples(last, k, n_seen, x, mag, hv, h, is_rate, bias, alpha, res):
     """Stage 6, the delay estimator: fold samples last + 1 … k into ``res[d]``, the moving
     average of the field's kinematic residual ``|Δm_j + h ω̄_{j−d} × m̄_j|²`` for each
     candidate delay d (samples): a field constant in the reference frame turns in the
     body frame as ``ṁ = −ω × m``, so a magnetometer d samples late matches the gyro of
     d samples earlier best (ω̄: the bias-corrected mean rate over the interval, m̄ the
-    mean field). Returns (last, samples seen); the delay is the argmin of ``res``."""
+    mean field, less the online hard-iron offset ``hv[V_APP]``, which does not turn).
+    Returns (last, samples seen); the delay is the argmin of ``res``."""
     dmax = res.size - 1
     while last < k:
         last += 1
@@ -883,9 +904,9 @@ def _fold_delay_samples(last, k, n_seen, x, mag, h, is_rate, bias, alpha, res):
         dm0 = mag[last, 0] - mag[last - 1, 0]
         dm1 = mag[last, 1] - mag[last - 1, 1]
         dm2 = mag[last, 2] - mag[last - 1, 2]
-        m0 = 0.5 * (mag[last, 0] + mag[last - 1, 0])
-        m1 = 0.5 * (mag[last, 1] + mag[last - 1, 1])
-        m2 = 0.5 * (mag[last, 2] + mag[last - 1, 2])
+        m0 = 0.5 * (mag[last, 0] + mag[last - 1, 0]) - hv[V_APP, 0]
+        m1 = 0.5 * (mag[last, 1] + mag[last - 1, 1]) - hv[V_APP, 1]
+        m2 = 0.5 * (mag[last, 2] + mag[last - 1, 2]) - hv[V_APP, 2]
         for d in range(dmax + 1):
             j = last - d  # the interval (j − 1, j]
             if is_rate:
@@ -1048,20 +1069,173 @@ def _mag_recovery(params, P, C, scale):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _heading_model(params, C, mn, dx, H, y):
+def _hi_steadier(hs, hv, hM):
+    """How much steadier the field's squared norm is with the estimate ``b`` (row V_B)
+    subtracted: the coefficient of variation of ``|m − b|²`` over that of ``|m|²``, both
+    over the forgetting sums, exactly for this ``b`` (``|m − b|² = |m|² − 2bᵀm + |b|²``,
+    whose mean and mean square are linear in Σ|m|², Σm, Σ|m|⁴, Σ|m|²m and Σmmᵀ); 1 when
+    the norm is constant. (For small variations the ratio is that of the norms' own
+    coefficients of variation, which :mod:`strapdown.ahrs.hard_iron` uses.)"""
+    w = hs[H_W]
+    eq = hs[H_Q] / w
+    var_q = hs[H_QQ] / w - eq * eq
+    if not var_q > 0.0:
+        return 1.0
+    beta = hv[V_B, 0] ** 2 + hv[V_B, 1] ** 2 + hv[V_B, 2] ** 2
+    bm = 0.0
+    bqm = 0.0
+    bmmb = 0.0
+    for a in range(3):
+        bm += hv[V_B, a] * hv[V_M, a]
+        bqm += hv[V_B, a] * hv[V_QM, a]
+        for d in range(3):
+            bmmb += hv[V_B, a] * hM[X_MM, a, d] * hv[V_B, d]
+    e1 = eq - 2.0 * bm / w + beta  # mean of |m − b|²
+    e2 = (hs[H_QQ] + 4.0 * bmmb - 4.0 * bqm + 2.0 * beta * hs[H_Q] - 4.0 * beta * bm) / w \
+        + beta * beta  # its mean square
+    var_c = max(e2 - e1 * e1, 0.0)
+    return np.sqrt(var_c / var_q) * eq / e1 if e1 > 0.0 else 1.0
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _hi_explained(hs, hv, hM, row):
+    """``1 − Σ|r − A b|² / Σ|r|² = (2 bᵀ Σ Aᵀr − bᵀ (Σ AᵀA) b) / Σ|r|²`` of the online
+    hard-iron sums for the offset ``b`` in row ``row`` of ``hv`` (0 while Σ|r|² is)."""
+    if not hs[H_RR] > 0.0:
+        return 0.0
+    acc = 0.0
+    for a in range(3):
+        acc += 2.0 * hv[row, a] * hv[V_Y, a]
+        for d in range(3):
+            acc -= hv[row, a] * hM[X_N, a, d] * hv[row, d]
+    return acc / hs[H_RR]
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _hi_distance(hv, i, j):
+    """|hv[i] − hv[j]|."""
+    return np.sqrt((hv[i, 0] - hv[j, 0]) ** 2 + (hv[i, 1] - hv[j, 1]) ** 2
+                   + (hv[i, 2] - hv[j, 2]) ** 2)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _hard_iron_span(params, ringC, j, e, m, tk, hs, hv, hM, r, S, Si, G):
+    """Stage 6, the online hard-iron estimate (the causal :mod:`strapdown.ahrs.hard_iron`):
+    at the end of each span of ``hi_span`` epochs, with the field ``m`` (body frame, the
+    offset applied added back) at the attitude ``ringC[j]`` and the previous span end's:
+    ``G m − G_p m_p = (G − G_p) b`` (the Earth's field constant in the reference frame),
+    ``G = Eᵀ C`` the gyro's own path — the filter's attitude without the corrections the
+    resets made, ``E = dcm(e)`` their product (a field that is off turns the filter's
+    heading back and forth as the body swings: with C itself the sums took that for
+    residual, and a 30 % offset on a swinging body explained 31 % instead of 59 %) —
+    summed with forgetting ``hi_forget`` per span as ``Σ AᵀA``, ``Σ Aᵀr``, ``Σ|r|²``;
+    ``b`` by ridge least squares (``hi_ridge`` times the trace: the directions the
+    rotations do not observe stay near zero, where ``b`` is a constant field in the
+    reference frame too). The offset applied becomes ``b`` once, for ``hi_hold_s``,
+    ``b`` explains at least ``hi_min_explained`` of ``Σ|r|²``, steadies the field's norm
+    (:func:`_hi_steadier` at most ``hi_steadier``) and drifts by at most ``hi_spread`` of
+    ``|b|`` — again when ``b`` moves from it by more than ``hi_spread`` of ``|b|`` — and
+    returns to zero when it explains less than nothing. Returns whether the offset
+    changed (the caller then takes the reference heading from the corrected sample in the
+    filter's own frame, so that the heading does not jump: carrying the old reference over
+    by the change of the mean field's heading assumed the filter had followed the raw
+    field; where it had rejected it as disturbed, the heading innovations then failed the
+    gate for ``recover_mag_s`` and the recovery turned the heading by 4°; the mean
+    corrected field's heading over the sums' window in the filter's frame, which had
+    wandered meanwhile, left a drift of 2.4° over the next 45 s). Work arrays r (3), S, Si,
+    G (3, 3). The offset applied is the    changed. Work arrays r (3), S, Si, G (3, 3)."""
+    lam = params.hi_forget
+    prev = hs[H_PREV] > 0.0
+    _dcm(e, S)
+    for a in range(3):
+        for c in range(3):
+            G[a, c] = S[0, a] * ringC[j, 0, c] + S[1, a] * ringC[j, 1, c] + S[2, a] * ringC[j, 2, c]
+    rr = 0.0
+    for a in range(3):
+        r[a] = 0.0
+        for c in range(3):
+            r[a] += G[a, c] * m[c] - hM[X_PREV, a, c] * hv[V_PREV, c]
+        rr += r[a] * r[a]
+    qm = m[0] * m[0] + m[1] * m[1] + m[2] * m[2]
+    for a in range(3):
+        if prev:
+            acc = 0.0
+            for c in range(3):
+                acc += (G[c, a] - hM[X_PREV, c, a]) * r[c]
+            hv[V_Y, a] = lam * hv[V_Y, a] + acc
+            for d in range(3):
+                acc = 0.0
+                for c in range(3):
+                    acc += (G[c, a] - hM[X_PREV, c, a]) * (G[c, d] - hM[X_PREV, c, d])
+                hM[X_N, a, d] = lam * hM[X_N, a, d] + acc
+        hv[V_M, a] = lam * hv[V_M, a] + m[a]
+        hv[V_QM, a] = lam * hv[V_QM, a] + qm * m[a]
+        for d in range(3):
+            hM[X_MM, a, d] = lam * hM[X_MM, a, d] + m[a] * m[d]
+    for a in range(3):  # this span's end is the next one's start
+        hv[V_PREV, a] = m[a]
+        for d in range(3):
+            hM[X_PREV, a, d] = G[a, d]
+    hs[H_PREV] = 1.0
+    if prev:
+        hs[H_RR] = lam * hs[H_RR] + rr
+    hs[H_W] = lam * hs[H_W] + 1.0
+    hs[H_Q] = lam * hs[H_Q] + qm
+    hs[H_QQ] = lam * hs[H_QQ] + qm * qm
+    if not prev:
+        return False
+    mu = params.hi_ridge * (hM[X_N, 0, 0] + hM[X_N, 1, 1] + hM[X_N, 2, 2])
+    for a in range(3):
+        for d in range(3):
+            S[a, d] = hM[X_N, a, d] + (mu if a == d else 0.0)
+    _inverse_sym(S, 3, Si)
+    for a in range(3):
+        hv[V_B, a] = Si[a, 0] * hv[V_Y, 0] + Si[a, 1] * hv[V_Y, 1] + Si[a, 2] * hv[V_Y, 2]
+    explained = _hi_explained(hs, hv, hM, V_B)
+    steadier = _hi_steadier(hs, hv, hM)
+    nb = np.sqrt(hv[V_B, 0] ** 2 + hv[V_B, 1] ** 2 + hv[V_B, 2] ** 2)
+    ok = (mu > 0.0 and hs[H_W] >= params.hi_min_spans and explained >= params.hi_min_explained
+          and steadier <= params.hi_steadier)
+    if ok and hs[H_HOLD] >= 0.0 and _hi_distance(hv, V_B, V_HOLD) > params.hi_spread * nb:
+        hs[H_HOLD] = -1.0  # drifted: hold again from here
+    if not ok:
+        hs[H_HOLD] = -1.0
+    elif hs[H_HOLD] < 0.0:
+        hs[H_HOLD] = tk
+        for a in range(3):
+            hv[V_HOLD, a] = hv[V_B, a]
+    applied = hv[V_APP, 0] != 0.0 or hv[V_APP, 1] != 0.0 or hv[V_APP, 2] != 0.0
+    if ok and hs[H_HOLD] >= 0.0 and tk - hs[H_HOLD] >= params.hi_hold_s and (
+            not applied or _hi_distance(hv, V_B, V_APP) > params.hi_update * nb):
+        for a in range(3):
+            hv[V_APP, a] = hv[V_B, a]
+    elif applied and _hi_explained(hs, hv, hM, V_APP) < 0.0:
+        # the offset applied explains less than none
+        for a in range(3):
+            hv[V_APP, a] = 0.0
+    else:
+        return False
+    hs[H_HOLD] = -1.0
+    return True
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _heading_model(ref_heading, C, mn, dx, H, y):
     """Stage 6, measurement: the heading of the field's horizontal part. Its Jacobian
     has the heading row ``−(C_n_b)₃`` and, through the field's dip, the tilt rows
     ``(m_z/m_h²)(m_x (C_n_b)₁ + m_y (C_n_b)₂)``: a tilt error about the field's
     horizontal direction shifts the measured heading by tan(dip) times itself.
     :func:`_consider_update` counts that in the innovation variance but keeps the
     update off roll and pitch. Fills H and the innovation y (wrapped to ±π); the
-    noise is ``heading_noise²/T`` (times ``mag_disturbed_factor`` while disturbed)."""
+    noise is ``heading_noise²/T`` (times ``mag_disturbed_factor`` while disturbed).
+    ``ref_heading``: the reference field's heading (``Params.ref_heading``, moved by the
+    online hard-iron estimate's offsets, :func:`_hard_iron_span`)."""
     mh2 = mn[0] * mn[0] + mn[1] * mn[1]
     cx = mn[2] * mn[0] / mh2
     cy = mn[2] * mn[1] / mh2
     for a in range(3):
         H[0, a] = cx * C[0, a] + cy * C[1, a] - C[2, a]
-    yv = np.arctan2(mn[1], mn[0]) - params.ref_heading
+    yv = np.arctan2(mn[1], mn[0]) - ref_heading
     if yv > np.pi:  # atan2 and the reference are in [−π, π]: one turn at most
         yv -= 2.0 * np.pi
     elif yv < -np.pi:
@@ -1239,6 +1413,21 @@ def ekf_kernel(sensors, prop, window, params, init, out):
     ms[M_CNORM] = params.ref_norm
     ms[M_CDIP] = params.ref_dip
     ms[M_UNDIST] = params.mag_settle_s
+    # the online hard-iron estimate (H_*, V_*, X_* indices; _hard_iron_span), the
+    # reference heading it moves, and the epochs left of re-referencing the norm and dip
+    hs = np.zeros(7)
+    hs[H_HOLD] = -1.0
+    hv = np.zeros((7, 3))
+    hM = np.zeros((3, 3, 3))
+    hr = np.empty(3)
+    hS = np.empty((3, 3))
+    hSi = np.empty((3, 3))
+    hG = np.empty((3, 3))
+    e_corr = np.zeros(4)  # the product of the resets' corrections, q(ε) ⊗ …
+    e_corr[0] = 1.0
+    m_raw = np.empty(3)
+    ref_heading = params.ref_heading
+    refer = 0
     dyn2 = 0.0  # moving mean square of the motion acceleration through the low-pass
     lp2 = np.zeros(3)  # slow mean of the low-passed specific force
     rest_since = -1.0  # start of the current run of rest detections (−1: none)
@@ -1338,23 +1527,47 @@ def ekf_kernel(sensors, prop, window, params, init, out):
         nis_mag = np.nan
         if params.use_magnetometer:
             if params.estimate_mag_delay:
-                last_d, n_delay_seen = _fold_delay_samples(last_d, k, n_delay_seen, x, mag, h,
+                last_d, n_delay_seen = _fold_delay_samples(last_d, k, n_delay_seen, x, mag, hv, h,
                                                            is_rate, bias, params.mag_delay_alpha,
                                                            delay_res)
                 if n_delay_seen > 0:
                     delay = _delay_choice(delay, delay_res, n_delay_seen, params.mag_delay_alpha,
                                           params.mag_delay_z)
             _store_dcm(ringC, step % n_delay, C)
-            _at_state_time(mag[k], k, x, h, is_rate, bias, params.meas_lead, mk)
-            nb = _delayed_field(ringC, (step - (delay + prop.stride // 2) // prop.stride)
-                                % n_delay, mk, mn)
+            jd = (step - (delay + prop.stride // 2) // prop.stride) % n_delay
+            for a in range(3):
+                m_raw[a] = mag[k, a] - hv[V_APP, a]
+            _at_state_time(m_raw, k, x, h, is_rate, bias, params.meas_lead, mk)
+            offset_changed = False
+            if params.hi_on:
+                hs[H_EPOCHS] += 1.0
+                if hs[H_EPOCHS] >= params.hi_span:
+                    hs[H_EPOCHS] = 0.0
+                    for a in range(3):
+                        m_raw[a] = mk[a] + hv[V_APP, a]
+                    if _hard_iron_span(params, ringC, jd, e_corr, m_raw, tk, hs, hv, hM, hr, hS,
+                                       hSi, hG):
+                        # the field with the new offset; its reference follows (below)
+                        flags |= F_MAG_OFFSET
+                        offset_changed = True
+                        refer = params.mc_init_n
+                        mc_n = 0  # the norm and dip's low-pass starts again
+                        mc_s0[:] = 0.0
+                        mc_s1[:] = 0.0
+                        for a in range(3):
+                            m_raw[a] = mag[k, a] - hv[V_APP, a]
+                        _at_state_time(m_raw, k, x, h, is_rate, bias, params.meas_lead, mk)
+            nb = _delayed_field(ringC, jd, mk, mn)
+            if offset_changed:  # the corrected sample's heading in the filter's frame
+                ref_heading = np.arctan2(mn[1], mn[0])
             nd_raw[0] = nb
             nd_raw[1] = -np.arcsin(min(max(mn[2] / nb, -1.0), 1.0)) if nb > 0.0 else 0.0
             mc_n = _lowpass(nd_raw, mc_n, params.mc_init_n, params.mc_b0, params.mc_b1,
                             params.mc_b2, params.mc_a1, params.mc_a2, mc_s0, mc_s1, nd)
             provisional = tk < params.mag_provisional_s
-            if provisional:
+            if provisional or refer > 0:
                 _mag_provisional(params, nd, ms)
+                refer = max(refer - 1, 0)
             dist = params.gating and _mag_disturbance(T, gm[0] ** 2 + gm[1] ** 2 + gm[2] ** 2,
                                                       params, nd, ms)
             horizontal = mn[0] ** 2 + mn[1] ** 2 > 1e-12 * nb * nb
@@ -1370,7 +1583,7 @@ def ekf_kernel(sensors, prop, window, params, init, out):
                 if force:
                     flags |= _mag_recovery(params, P, C,
                                            1.0 if due else T / PROVISIONAL_RECOVER_S)
-                _heading_model(params, C, mn, dx, H_mag, y1)
+                _heading_model(ref_heading, C, mn, dx, H_mag, y1)
                 nis_mag, ok = _consider_update(P, H_mag, params.heading_noise ** 2 / T
                                                * (_disturbed_factor(params, nd, ms) if dist
                                                   else 1.0),
@@ -1389,6 +1602,9 @@ def ekf_kernel(sensors, prop, window, params, init, out):
         # stage 7: reset
         _reset((e if step >= n_start else step + 1) % lag, q, ring, bias, accel, acc_bias, P,
                C, dx, eps, singer)
+        if params.hi_on:  # the hard-iron estimate's gyro path leaves the correction out
+            e_corr[0], e_corr[1], e_corr[2], e_corr[3] = _left_rotated(
+                eps, e_corr[0], e_corr[1], e_corr[2], e_corr[3])
         if lp_n > 0:  # the low-passed reference-frame specific force follows the correction
             _rotate_small(eps, lp)
             _rotate_small(eps, lp_s0)
@@ -1416,7 +1632,7 @@ def ekf_kernel(sensors, prop, window, params, init, out):
         out_flags[k] = flags
         out_nis[k, 0] = nis_acc
         out_nis[k, 1] = nis_mag
-    return total, g_meas, g_known
+    return total, g_meas, g_known, hv[V_APP, 0], hv[V_APP, 1], hv[V_APP, 2]
 
 
 @njit(cache=True, error_model="numpy")

@@ -79,6 +79,16 @@ __all__ = ["AhrsConfig", "AhrsResult", "attitude_from_acc_mag", "butterworth", "
            "offline_ekf", "start_is_still", "window_bias_sigma"]
 
 G = 9.80665
+#: The online hard-iron estimate's ridge, a fraction of the trace of its normal matrix: the
+#: directions the rotations leave unobserved stay near zero; the observed ones are
+#: shrunk by 0.3 % or less (3 × 1e-3 when the three are observed alike; 1e-2 shrank a
+#: turning body's offset by 4 %) (``_kernel._hard_iron_span``).
+HI_RIDGE = 1e-3
+#: The online estimate replaces the offset applied when it has moved from it by more than
+#: this fraction of itself (each change carries the field's reference over; with
+#: ``SPREAD_MAX``, 0.2, an offset applied 4 % off stayed, and its residual turned the
+#: heading by up to 0.8° with the orientation).
+HI_UPDATE = 0.02
 #: q_NED_ENU: rotation by π about (1, 1, 0)/√2 (swaps x and y, flips z).
 Q_NED_ENU = np.array([0.0, math.sqrt(0.5), math.sqrt(0.5), 0.0])
 
@@ -256,6 +266,28 @@ class AhrsConfig:
         there for part of the trial); on the simulated recordings with an offset of 30 % of
         the field's norm 44–96 % where the body swings, shakes or spins, and the halves
         agree (docs/reproductions.md, "A magnetometer that is not calibrated").
+    hard_iron_s : float
+        :func:`ekf` estimates the magnetometer's hard-iron offset online, the causal form of
+        :func:`strapdown.ahrs.hard_iron.hard_iron` (``_kernel._hard_iron_span``): every
+        0.1 s the field's change against the filter's rotation, ``C m − C_p m_p = (C −
+        C_p) b``, is added to least-squares sums that forget with this time constant (s;
+        0 switches the estimate off). Once the estimate has, for ``hard_iron_hold_s``,
+        explained at least ``hard_iron_min_explained`` of the field's change that the
+        rotation leaves, steadied the field's norm (:data:`~strapdown.ahrs.hard_iron.
+        STEADIER_MAX`) and drifted by no more than
+        :data:`~strapdown.ahrs.hard_iron.SPREAD_MAX` of itself, it is subtracted from
+        every later sample (again when it moves by more than :data:`HI_UPDATE` of itself;
+        back to none when it explains less than none); the field's reference norm and dip
+        are learned again from the corrected field, and its reference heading is the
+        corrected sample's in the filter's own frame, so that the heading does not jump
+        (``MeasurementFlag.MAG_OFFSET``); the magnetometer-delay estimator takes the
+        corrected field too. Default 30. :func:`offline_ekf` subtracts its own
+        whole-record estimate instead (``offline_hard_iron_min_explained``) and runs its
+        passes without this one.
+    hard_iron_hold_s : float
+        See ``hard_iron_s``; s. Default 5.
+    hard_iron_min_explained : float
+        See ``hard_iron_s``. Default 0.3, as ``offline_hard_iron_min_explained``.
     mag_delay_s : float
         Delay of the magnetometer behind the gyro, s: each field sample is rotated
         with the attitude of that long ago (rounded to whole filter epochs). With
@@ -420,6 +452,9 @@ class AhrsConfig:
     offline_mag_reject_s: float = math.inf
     offline_smooth_s: float = 4.0
     offline_hard_iron_min_explained: float = 0.3
+    hard_iron_s: float = 30.0
+    hard_iron_hold_s: float = 5.0
+    hard_iron_min_explained: float = 0.3
     mag_delay_s: float = 0.0
     estimate_mag_delay: bool = True
     mag_delay_max_s: float = 0.02
@@ -489,7 +524,8 @@ _ANY_SIGN = ("declination_deg",)
 _NON_NEGATIVE = ("lever_arm", "acc_motion_leak", "tilt_rate_noise", "heading_rate_noise",
                  "offline_heading_rate_noise", "offline_smooth_s",
                  "mag_reject_s", "rest_min_s", "mag_delay_s", "latency_s", "mag_delay_max_s",
-                 "mag_disturbed_power", "offline_mag_reject_s", "mag_delay_z")
+                 "mag_disturbed_power", "offline_mag_reject_s", "mag_delay_z", "hard_iron_s",
+                 "hard_iron_hold_s", "hard_iron_min_explained")
 
 
 @dataclass(frozen=True)
@@ -541,8 +577,12 @@ class AhrsResult:
         The initial window was still (:func:`start_is_still`); False: the filter started
         in motion (see the module docstring).
     mag_offset : ndarray (3,) or None
-        The hard-iron offset :func:`offline_ekf` subtracted from the field (body frame, the
-        field's unit; ``AhrsConfig.offline_hard_iron_min_explained``); None when none was.
+        The hard-iron offset subtracted from the field (body frame, the field's unit): by
+        :func:`offline_ekf`, its whole-record estimate
+        (``AhrsConfig.offline_hard_iron_min_explained``); by :func:`ekf`, the online
+        estimate's at the end (``AhrsConfig.hard_iron_s``; the flag
+        ``MeasurementFlag.MAG_OFFSET`` marks the samples where it changed). None when none
+        was.
     """
 
     t: np.ndarray
@@ -763,6 +803,9 @@ def _derived(cfg: AhrsConfig, ref, use_mag: bool, h: float, te: float,
     lp = butterworth(cfg.acc_lowpass_s, te)
     mc = butterworth(cfg.mag_current_s, te)
     lp_init_n = max(1, math.ceil(cfg.acc_lowpass_s / te - 1e-9))
+    from strapdown.ahrs.hard_iron import SPAN_S, SPREAD_MAX, STEADIER_MAX
+
+    hi_span = max(1, round(SPAN_S / te))
     return {"ref_norm": ref[0], "ref_dip": ref[1], "ref_heading": ref[2],
             "use_magnetometer": use_mag, "soft_gate": cfg.acc_gate_mode == "soft",
             "acc_lowpass": cfg.acc_model == "lowpass",
@@ -780,7 +823,13 @@ def _derived(cfg: AhrsConfig, ref, use_mag: bool, h: float, te: float,
             "meas_lead": (0.5 * h if cfg.gyro_sample == "interval" and cfg.mag_sample == "point"
                           else 0.0),
             "gravity_measured": start.gravity, "gravity_known": start.gravity_known,
-            "mag_provisional_s": start.mag_provisional_s}
+            "mag_provisional_s": start.mag_provisional_s,
+            "hi_on": use_mag and cfg.hard_iron_s > 0, "hi_span": hi_span,
+            "hi_forget": math.exp(-hi_span * te / cfg.hard_iron_s) if cfg.hard_iron_s > 0
+            else 0.0, "hi_ridge": HI_RIDGE, "hi_min_explained": cfg.hard_iron_min_explained,
+            "hi_steadier": STEADIER_MAX, "hi_spread": SPREAD_MAX, "hi_update": HI_UPDATE,
+            "hi_hold_s": cfg.hard_iron_hold_s,
+            "hi_min_spans": cfg.hard_iron_hold_s / (hi_span * te)}
 
 
 def _params(cfg: AhrsConfig, ref, use_mag: bool, h: float, te: float,
@@ -854,9 +903,9 @@ def _run(rec, acc, mag, prop: K.Propagation, window: K.Window, params: K.Params,
     out.attitude_cov[0] = init.P[:3, :3]
     out.bias_var[0] = np.diag(init.P)[3:6]
     out.mag_delay[0] = params.mag_delay
-    k, g, g_known = K.ekf_kernel(K.Sensors(np.ascontiguousarray(x), acc, mag, float(h)), prop,
-                                 window, params, init, out)
-    return out, k, (float(g), bool(g_known))
+    k, g, g_known, *offset = K.ekf_kernel(K.Sensors(np.ascontiguousarray(x), acc, mag,
+                                                    float(h)), prop, window, params, init, out)
+    return out, k, (float(g), bool(g_known)), np.array(offset)
 
 
 def _fill_between_epochs(rec, q, bias, last):
@@ -996,8 +1045,8 @@ def _filter(rec, acc, mag, have_mag: bool, cfg: AhrsConfig, algorithm: str, q_in
                                                      start.gyro_bias_sigma0))
     params = _params(cfg, ref, have_mag, rec.td, prop.stride * rec.td, start)._replace(
         store_covariance=store_covariance)
-    out, k, gravity = _run(rec, acc, mag, prop, window, params, init)
-    return out, _fill(rec, out, k), gravity
+    out, k, gravity, offset = _run(rec, acc, mag, prop, window, params, init)
+    return out, _fill(rec, out, k), gravity, offset
 
 
 def ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
@@ -1047,8 +1096,10 @@ def ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
     cfg = config or AhrsConfig()
     rec, acc, mag, have_mag, q_init, b0, ref, start = _setup(t, gyro, acc, mag, cfg, q0,
                                                               gyro_bias0, mag_reference, frame)
-    out, epoch, _ = _filter(rec, acc, mag, have_mag, cfg, algorithm, q_init, b0, ref, start)
-    return _result(rec, out, epoch, frame, have_mag, algorithm, cfg, start)
+    out, epoch, _, offset = _filter(rec, acc, mag, have_mag, cfg, algorithm, q_init, b0, ref,
+                                    start)
+    return replace(_result(rec, out, epoch, frame, have_mag, algorithm, cfg, start),
+                   mag_offset=offset if np.any(offset) else None)
 
 
 def _backward(rec, acc, mag, have_mag: bool, cfg: AhrsConfig, algorithm: str, fwd, ref,
@@ -1079,7 +1130,8 @@ def _backward(rec, acc, mag, have_mag: bool, cfg: AhrsConfig, algorithm: str, fw
                     attitude_sigma0=max(sig_att, 1e-4), gyro_bias_sigma0=max(sig_bias, 1e-6))
     # its start is the forward pass's end: still or not, no window is averaged; gravity is
     # what the forward pass ended with
-    out, epoch, _ = _filter(rec_b, np.ascontiguousarray(acc[::-1]), np.ascontiguousarray(mag_b),
+    out, epoch, _, _ = _filter(rec_b, np.ascontiguousarray(acc[::-1]),
+                               np.ascontiguousarray(mag_b),
                             have_mag, cfg_b, algorithm, fwd.q[-1], -fwd.gyro_bias[-1], ref,
                             _Start(True, *gravity, cfg_b.attitude_sigma0), True)
     _to_stamps(out, rec_b.omega, rec, cfg)
@@ -1163,7 +1215,8 @@ def offline_ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
     gyro's own path is removed (zero-phase; :class:`AhrsConfig`). Before the passes, a
     hard-iron offset of the magnetometer found from the gyro over the whole record is
     subtracted when the tests of ``offline_hard_iron_min_explained`` pass
-    (:mod:`strapdown.ahrs.hard_iron`; ``AhrsResult.mag_offset``). Arguments
+    (:mod:`strapdown.ahrs.hard_iron`; ``AhrsResult.mag_offset``); the passes run without
+    the online estimate (``hard_iron_s``). Arguments
     as for :func:`ekf`; the result has ``smoothed`` set, its flags, NIS and
     manoeuvre acceleration are the forward pass's.
 
@@ -1180,8 +1233,9 @@ def offline_ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
     rec, acc, mag, have_mag, q_init, b0, ref, start = _prepare(rec, acc, mag, have_mag, cfg,
                                                                 q0, gyro_bias0, mag_reference,
                                                                 frame)
-    cfg_pass = replace(cfg, heading_rate_noise=cfg.offline_heading_rate_noise)
-    fwd, epoch, gravity = _filter(rec, acc, mag, have_mag, cfg_pass, algorithm, q_init, b0,
+    # the passes share the reference field and the offset: no online estimate in either
+    cfg_pass = replace(cfg, heading_rate_noise=cfg.offline_heading_rate_noise, hard_iron_s=0.0)
+    fwd, epoch, gravity, _ = _filter(rec, acc, mag, have_mag, cfg_pass, algorithm, q_init, b0,
                                   ref, start, True)
     _to_stamps(fwd, rec.omega, rec, cfg)
     bwd, _ = _backward(rec, acc, mag, have_mag, cfg_pass, algorithm, fwd, ref, gravity)

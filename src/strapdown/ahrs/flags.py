@@ -42,6 +42,10 @@ class MeasurementFlag(enum.IntFlag):
     ACC_DISTURBED
         Raw accelerometer model: the specific force's norm departed from g by
         more than ``acc_norm_tol``: no accelerometer update.
+    MAG_OFFSET
+        The online hard-iron estimate changed the offset subtracted from the field
+        (``AhrsConfig.hard_iron_s``; :attr:`strapdown.ahrs.AhrsResult.mag_offset` is
+        the last one): the field's reference norm, dip and heading were carried over.
     """
 
     ACC_USED = 1
@@ -53,3 +57,4 @@ class MeasurementFlag(enum.IntFlag):
     ACC_RECOVERED = 64
     MAG_RECOVERED = 128
     ACC_DISTURBED = 256
+    MAG_OFFSET = 512

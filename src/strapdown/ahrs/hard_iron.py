@@ -40,7 +40,12 @@ from strapdown._core.validation import finite_array
 from strapdown.ahrs import _kernel as K
 from strapdown.algorithms.rate import check_rate_record
 
-__all__ = ["SPREAD_MAX", "STEADIER_MAX", "HardIron", "hard_iron"]
+__all__ = ["SPAN_S", "SPREAD_MAX", "STEADIER_MAX", "HardIron", "hard_iron"]
+
+#: The span over which the gyro's rotation is set against the field's change, s: long
+#: enough for the rotation to stand out of the field's noise, short enough for the gyro's
+#: drift.
+SPAN_S = 0.1
 
 #: A hard iron is constant: the two halves' offsets may differ by at most this fraction of
 #: the whole record's (simulated offsets: ≤ 0.04; BROAD's 2 cm magnet, attached for part of
@@ -82,7 +87,7 @@ class HardIron:
     steadier: float
 
 
-def hard_iron(t: ArrayLike, gyro: ArrayLike, mag: ArrayLike, *, span_s: float = 0.1,
+def hard_iron(t: ArrayLike, gyro: ArrayLike, mag: ArrayLike, *, span_s: float = SPAN_S,
               min_eigen: float = 0.05, gyro_sample: str = "interval") -> HardIron:
     """Estimate a magnetometer's hard-iron offset from the gyro (module docstring).
 
@@ -97,8 +102,7 @@ def hard_iron(t: ArrayLike, gyro: ArrayLike, mag: ArrayLike, *, span_s: float = 
     mag : array_like (n, 3)
         The field in the body, any unit.
     span_s : float
-        Length of each span (s; at least one sample). Default 0.1: long enough for the
-        rotation to stand out of the field's noise, short enough for the gyro's drift.
+        Length of each span (s; at least one sample). Default :data:`SPAN_S`.
     min_eigen : float
         A direction is observed when its eigenvalue of ``Σ (I − R)ᵀ(I − R)`` is at least this
         fraction of the largest. Default 0.05.
@@ -126,7 +130,7 @@ def hard_iron(t: ArrayLike, gyro: ArrayLike, mag: ArrayLike, *, span_s: float = 
     return _hard_iron(rec.omega, m, rec.td, span_s, min_eigen, gyro_sample)
 
 
-def _hard_iron(omega, m, td: float, span_s: float = 0.1, min_eigen: float = 0.05,
+def _hard_iron(omega, m, td: float, span_s: float = SPAN_S, min_eigen: float = 0.05,
                gyro_sample: str = "interval") -> HardIron:
     """:func:`hard_iron` on a validated record: rates and field (n, 3), uniform period
     ``td``."""

@@ -128,9 +128,12 @@ def run(args: argparse.Namespace) -> int:
     if not res.heading_observed:
         say("warning: no magnetometer: heading is not observed (gyro integral from yaw 0)")
     if res.mag_offset is not None:
+        how = ("the offline filter subtracted" if res.smoothed else
+               "the filter estimated it online and subtracted, at the end,")
+        see = ("offline_hard_iron_min_explained" if res.smoothed else "hard_iron_s")
         say("note: the magnetometer carries a hard-iron offset (a field fixed in the body); "
-            f"the offline filter subtracted {[round(float(x), 6) for x in res.mag_offset]} "
-            "(its unit; see AhrsConfig.offline_hard_iron_min_explained)")
+            f"{how} {[round(float(x), 6) for x in res.mag_offset]} "
+            f"(its unit; see AhrsConfig.{see})")
     if not res.start_still:
         say("note: the recording starts in motion (its first "
             f"{cfg.init_window_s:g} s are not still): the first seconds converge from a "
