@@ -1,5 +1,6 @@
-"""The guarded HDF5 reader: run as ``python -m strapdown.io._hdf5_child`` by
-:func:`strapdown.io.containers.read_hdf5`, never imported by the library.
+"""The guarded HDF5 reader: run as ``python -P .../strapdown/io/_hdf5_child.py`` by
+:func:`strapdown.io.containers.read_hdf5` (by its path: it imports nothing of the package),
+never imported by the library.
 
 Reads one JSON request on stdin (``path``, dataset ``names``, root ``attrs``, ``matlab``,
 ``max_bytes``, ``max_ratio``) and writes one JSON line — ``names`` (the file's top-level

@@ -491,13 +491,19 @@ def read_hdf5(path: str | os.PathLike[str], names: Iterable[str], attrs: Iterabl
                "matlab": matlab, "max_bytes": max_bytes(), "max_ratio": max_ratio()}
     timeout = 60.0 + size / 20e6
     try:
-        proc = subprocess.run([sys.executable, "-m", "strapdown.io._hdf5_child"],
+        # the script by its path (-P: its folder not on sys.path), not ``-m``: the child needs
+        # numpy and h5py only, and importing the package first cost each read ~0.1 CPU-s
+        proc = subprocess.run([sys.executable, "-P", str(_HDF5_CHILD)],
                               input=json.dumps(request).encode(), capture_output=True,
                               timeout=timeout, check=False)
     except subprocess.TimeoutExpired:
         raise InputError(f"{path}: reading the HDF5 file took longer than {timeout:.0f} s; "
                          "it is corrupt or far larger than it looks") from None
     return _child_result(path, proc, matlab)
+
+
+#: The guarded reader's script (run in a child process; see :func:`read_hdf5`).
+_HDF5_CHILD = Path(__file__).with_name("_hdf5_child.py")
 
 
 def _child_result(path: Path, proc: subprocess.CompletedProcess, matlab: bool) -> Arrays:
