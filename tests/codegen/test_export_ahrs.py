@@ -185,6 +185,29 @@ def test_a_start_in_motion_equals_library(tmp_path, algorithm, changes, mag):
     np.testing.assert_array_equal(fl[e.init_samples - 1:], res.flags[e.init_samples - 1:])
 
 
+@pytest.mark.parametrize("real", ["double", "float"])
+def test_an_online_hard_iron_equals_library(tmp_path, real):
+    """The online hard-iron estimate (``_kernel._hard_iron_span``): the spun-and-coned record
+    with a 40 % offset in its field — the library applies an offset (``MAG_OFFSET``) — row
+    by row as the library's: double to ``DOUBLE_RAD`` with the same flags, float within the
+    float bounds."""
+    t, gyro, acc, m = MOVING
+    m = m + np.array([9.0, -14.0, 6.0])
+    res = ekf(t, gyro, acc, m)
+    assert np.any(res.flags & int(K.F_MAG_OFFSET)) and res.mag_offset is not None
+    h = check_rate_record(t, gyro, min_samples=4).td
+    e, lib = build(tmp_path, h=h, real=real, mag=True, algorithm="rate-single",
+                   config=AhrsConfig(), name=f"hi_{real}")
+    q, rc, fl = run(e, lib, gyro, acc, m)
+    err = _compare(res, q, rc, fl, e.init_samples)
+    if real == "double":
+        assert err.max() <= DOUBLE_RAD, (err.max(), int(err.argmax()))
+        np.testing.assert_array_equal(fl[e.init_samples - 1:], res.flags[e.init_samples - 1:])
+    else:
+        deg = np.degrees(err)
+        assert deg.mean() <= FLOAT_MEAN_DEG and deg.max() <= FLOAT_MAX_DEG
+
+
 def test_chunks_equal_one_stream(tmp_path):
     # the state is all the filter keeps: any split of the record gives the same rows
     _t, gyro, acc, mag = SIM
