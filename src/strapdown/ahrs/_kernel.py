@@ -87,12 +87,12 @@ F_MAG_OFFSET = int(MeasurementFlag.MAG_OFFSET)
 # norm, dip and time, time rejected
 M_NORM, M_DIP, M_UNDIST, M_DIST, M_CNORM, M_CDIP, M_CT, M_REJECT = range(8)
 # the online hard-iron estimate (:func:`_hard_iron_span`), its sums forgetting: scalars —
-# Σ|r|², Σ 1, Σ|m|², Σ|m|⁴, when its tests began to hold (−1: not holding), epochs since the
-# last span, whether a previous span end is stored (0/1) —, vectors — Σ Aᵀr, the estimate
+# Σ|r|², Σ 1, Σ|m|², Σ|m|⁴, when its tests began to hold (−1: not holding), whether a
+# previous span end is stored (0/1) —, vectors — Σ Aᵀr, the estimate
 # b, the offset applied, b when the tests began to hold, the previous span end's field
 # (body), Σ m, Σ |m|² m — and matrices — Σ AᵀA, the previous span end's gyro-path C_n_b,
 # Σ m mᵀ
-H_RR, H_W, H_Q, H_QQ, H_HOLD, H_EPOCHS, H_PREV = range(7)
+H_RR, H_W, H_Q, H_QQ, H_HOLD, H_PREV = range(6)
 V_Y, V_B, V_APP, V_HOLD, V_PREV, V_M, V_QM = range(7)
 X_N, X_PREV, X_MM = range(3)
 #: The slow mean of the low-passed specific force (:func:`_motion_power`) has this many
@@ -1118,8 +1118,8 @@ def _hi_distance(hv, i, j):
                    + (hv[i, 2] - hv[j, 2]) ** 2)
 
 
-# Not inlined: it runs once per span (0.1 s), and inlined into the loop it doubled the
-# kernel's cold compile (ekf_kernel 30 → 66 CPU-s).
+# Not inlined: it runs once per span (0.1 s), and inlined into the loop it made the kernel's
+# cold compile longer (one ekf call with an empty cache: 68.0 CPU-s, 55.8 as a call).
 @njit(cache=True, error_model="numpy")
 def _hard_iron_span(params, ringC, j, e, m, tk, hs, hv, hM, r, S, Si, G):
     """Stage 6, the online hard-iron estimate (the causal :mod:`strapdown.ahrs.hard_iron`):
@@ -1136,16 +1136,16 @@ def _hard_iron_span(params, ringC, j, e, m, tk, hs, hv, hM, r, S, Si, G):
     reference frame too). The offset applied becomes ``b`` once, for ``hi_hold_s``,
     ``b`` explains at least ``hi_min_explained`` of ``Σ|r|²``, steadies the field's norm
     (:func:`_hi_steadier` at most ``hi_steadier``) and drifts by at most ``hi_spread`` of
-    ``|b|`` — again when ``b`` moves from it by more than ``hi_spread`` of ``|b|`` — and
+    ``|b|`` — again when ``b`` moves from it by more than ``hi_update`` of ``|b|`` — and
     returns to zero when it explains less than nothing. Returns whether the offset
-    changed (the caller then takes the reference heading from the corrected sample in the
-    filter's own frame, so that the heading does not jump: carrying the old reference over
+    changed; the caller then takes the reference heading from the corrected sample in the
+    filter's own frame, so that the heading does not jump (carrying the old reference over
     by the change of the mean field's heading assumed the filter had followed the raw
     field; where it had rejected it as disturbed, the heading innovations then failed the
     gate for ``recover_mag_s`` and the recovery turned the heading by 4°; the mean
     corrected field's heading over the sums' window in the filter's frame, which had
     wandered meanwhile, left a drift of 2.4° over the next 45 s). Work arrays r (3), S, Si,
-    G (3, 3). The offset applied is the    changed. Work arrays r (3), S, Si, G (3, 3)."""
+    G (3, 3)."""
     lam = params.hi_forget
     prev = hs[H_PREV] > 0.0
     _dcm(e, S)
@@ -1417,7 +1417,7 @@ def ekf_kernel(sensors, prop, window, params, init, out):
     ms[M_UNDIST] = params.mag_settle_s
     # the online hard-iron estimate (H_*, V_*, X_* indices; _hard_iron_span), the
     # reference heading it moves, and the epochs left of re-referencing the norm and dip
-    hs = np.zeros(7)
+    hs = np.zeros(6)
     hs[H_HOLD] = -1.0
     hv = np.zeros((7, 3))
     hM = np.zeros((3, 3, 3))
@@ -1542,9 +1542,7 @@ def ekf_kernel(sensors, prop, window, params, init, out):
             _at_state_time(m_raw, k, x, h, is_rate, bias, params.meas_lead, mk)
             offset_changed = False
             if params.hi_on:
-                hs[H_EPOCHS] += 1.0
-                if hs[H_EPOCHS] >= params.hi_span:
-                    hs[H_EPOCHS] = 0.0
+                if (step + 1) % params.hi_span == 0:  # a span ends with this epoch
                     for a in range(3):
                         m_raw[a] = mk[a] + hv[V_APP, a]
                     if _hard_iron_span(params, ringC, jd, e_corr, m_raw, tk, hs, hv, hM, hr, hS,

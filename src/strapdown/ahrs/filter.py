@@ -269,9 +269,10 @@ class AhrsConfig:
     hard_iron_s : float
         :func:`ekf` estimates the magnetometer's hard-iron offset online, the causal form of
         :func:`strapdown.ahrs.hard_iron.hard_iron` (``_kernel._hard_iron_span``): every
-        0.1 s the field's change against the filter's rotation, ``C m − C_p m_p = (C −
-        C_p) b``, is added to least-squares sums that forget with this time constant (s;
-        0 switches the estimate off). Once the estimate has, for ``hard_iron_hold_s``,
+        0.1 s the field's change against the gyro's own rotation (the filter's attitude
+        without its corrections), ``G m − G_p m_p = (G − G_p) b``, is added to
+        least-squares sums that forget with this time constant (s; 0 switches the estimate
+        off). Once the estimate has, for ``hard_iron_hold_s``,
         explained at least ``hard_iron_min_explained`` of the field's change that the
         rotation leaves, steadied the field's norm (:data:`~strapdown.ahrs.hard_iron.
         STEADIER_MAX`) and drifted by no more than
