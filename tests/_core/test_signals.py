@@ -1,6 +1,8 @@
 """``replaced_handlers``: SIGINT's and SIGTERM's handlers swapped for a block, put back after
 it, untouched outside the main thread; ``interrupts_kept``: an interrupt landing in a
-finaliser raised again, not printed and lost."""
+finaliser raised again, not printed and lost; ``interrupts_deferred``: a signal held back
+until the block checks, then delivered to the previous handler once the block has unwound;
+``raised_outside_numba``: no signal's exception inside numba's or llvmlite's code."""
 
 from __future__ import annotations
 
@@ -11,7 +13,13 @@ import time
 
 import pytest
 
-from strapdown._core.signals import INTERRUPTING, interrupts_kept, replaced_handlers
+from strapdown._core.signals import (
+    INTERRUPTING,
+    interrupts_deferred,
+    interrupts_kept,
+    raised_outside_numba,
+    replaced_handlers,
+)
 
 
 def test_handlers_are_replaced_for_the_block_and_put_back_after_an_exception():
@@ -76,3 +84,94 @@ def test_other_unraisable_exceptions_still_reach_the_previous_hook():
     finally:
         sys.unraisablehook = previous
     assert [type(u.exc_value) for u in seen] == [RuntimeError]
+
+
+def test_a_deferred_ctrl_c_waits_for_the_check_and_unwinds_the_block_first():
+    events = []
+    with pytest.raises(KeyboardInterrupt):
+        with interrupts_deferred() as check:
+            try:
+                signal.raise_signal(signal.SIGINT)
+                events.append("after the signal")  # not interrupted here
+                check()
+                events.append("after the check")  # never
+            finally:
+                events.append(("cleanup", signal.getsignal(signal.SIGINT)
+                               is signal.default_int_handler))  # still deferred
+    assert events == ["after the signal", ("cleanup", False)]
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+
+
+def test_a_deferred_sigterm_reaches_the_previous_handler_once_the_block_is_left():
+    got = []
+
+    class Term(KeyboardInterrupt):
+        pass
+
+    def previous(signum, frame):
+        got.append(signum)
+        raise Term()
+
+    with replaced_handlers(previous):
+        with pytest.raises(Term):
+            with interrupts_deferred() as check:
+                signal.raise_signal(signal.SIGTERM)
+                assert got == []
+                check()
+        assert got == [signal.SIGTERM]
+
+
+def test_a_signal_noted_but_not_checked_is_delivered_at_the_block_end():
+    reached = []
+    with pytest.raises(KeyboardInterrupt):
+        with interrupts_deferred():
+            signal.raise_signal(signal.SIGINT)
+            reached.append(True)
+    assert reached == [True]
+
+
+def test_a_previous_handler_that_returns_still_cuts_the_block_short():
+    with replaced_handlers(lambda signum, frame: None):
+        with pytest.raises(KeyboardInterrupt), interrupts_deferred() as check:
+            signal.raise_signal(signal.SIGINT)
+            check()
+
+
+def test_without_a_signal_the_check_does_nothing_and_ignored_signals_stay_ignored():
+    with replaced_handlers(signal.SIG_IGN):
+        with interrupts_deferred() as check:
+            assert [signal.getsignal(s) for s in INTERRUPTING] == [signal.SIG_IGN] * 2
+            check()
+            signal.raise_signal(signal.SIGINT)  # ignored, as before
+            check()
+
+
+_INSIDE = """
+def inside(log):
+    signal.raise_signal(signal.SIGINT)
+    start = time.monotonic()
+    while time.monotonic() - start < 0.05:  # many bytecodes, each a chance to raise
+        pass
+    log.append("returned")
+"""
+
+
+@pytest.mark.parametrize("module", ["llvmlite.binding.ffi", "numba.core.caching"])
+def test_an_interrupt_inside_numba_or_llvmlite_comes_once_the_call_has_returned(module):
+    ns = {"__name__": module, "signal": signal, "time": time}
+    exec(_INSIDE, ns)  # a function whose code belongs to that module
+    log = []
+    with replaced_handlers(raised_outside_numba(signal.default_int_handler)):
+        with pytest.raises(KeyboardInterrupt):
+            ns["inside"](log)
+            log.append("outside")
+            deadline = time.monotonic() + 5
+            while time.monotonic() < deadline:  # the interrupt arrives here, retried
+                time.sleep(1e-3)
+    assert log == ["returned", "outside"]
+
+
+def test_an_interrupt_outside_numba_is_raised_at_once():
+    with replaced_handlers(raised_outside_numba(signal.default_int_handler)):
+        with pytest.raises(KeyboardInterrupt):
+            signal.raise_signal(signal.SIGINT)

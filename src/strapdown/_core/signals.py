@@ -1,24 +1,32 @@
 """The command line's interrupting signals (Ctrl-C's SIGINT, SIGTERM) handled differently
 for the length of a block (:func:`replaced_handlers`), and never lost in a finaliser
-(:func:`interrupts_kept`)."""
+(:func:`interrupts_kept`), never acted on inside numba or llvmlite (:func:`raised_outside_numba`),
+or held back until the code asks (:func:`interrupts_deferred`)."""
 
 from __future__ import annotations
 
 import _thread
 import contextlib
+import os
 import signal
 import sys
 import threading
 from collections.abc import Callable, Iterator
 from typing import Any
 
-__all__ = ["INTERRUPTING", "interrupts_kept", "replaced_handlers"]
+__all__ = ["INTERRUPTING", "interrupts_deferred", "interrupts_kept", "raised_outside_numba",
+           "replaced_handlers"]
 
 #: The signals the command line turns into an exception (``KeyboardInterrupt``).
 INTERRUPTING = (signal.SIGINT, signal.SIGTERM)
 
 #: How long after an interrupt lost in a finaliser it is raised again (:func:`interrupts_kept`).
 REDELIVERY_DELAY_S = 1e-3
+#: The top-level packages whose Python code a signal's exception is never raised in
+#: (:func:`raised_outside_numba`).
+NOT_INTERRUPTIBLE = ("numba", "llvmlite")
+#: How often a signal held back by :func:`raised_outside_numba` is tried again (seconds).
+RETRY_S = 0.01
 
 
 @contextlib.contextmanager
@@ -60,10 +68,14 @@ def interrupts_kept() -> Iterator[None]:
 
     def hook(unraisable: Any) -> None:
         if isinstance(unraisable.exc_value, KeyboardInterrupt):
-            again = threading.Timer(REDELIVERY_DELAY_S, _thread.interrupt_main)
-            again.daemon = True
-            again.start()
-            return
+            while True:
+                try:
+                    again = threading.Timer(REDELIVERY_DELAY_S, _thread.interrupt_main)
+                    again.daemon = True
+                    again.start()
+                    return
+                except KeyboardInterrupt:  # the redelivery landed in this hook (a loaded
+                    continue  # machine starts the thread slowly): Python would drop it too
         previous(unraisable)
 
     sys.unraisablehook = hook
@@ -71,3 +83,92 @@ def interrupts_kept() -> Iterator[None]:
         yield
     finally:
         sys.unraisablehook = previous
+
+
+class _Deferred(BaseException):
+    """Raised by :func:`interrupts_deferred`'s check: unwinds the block to where the signal
+    is delivered again. Never seen outside it."""
+
+
+@contextlib.contextmanager
+def interrupts_deferred() -> Iterator[Callable[[], None]]:
+    """For the block, SIGINT and SIGTERM are noted, not acted on, until the block calls the
+    check it is given; the signal is then delivered again, to its previous handler, once
+    the block has unwound.
+
+    Python raises Ctrl-C's ``KeyboardInterrupt`` at whatever bytecode runs next, which may be
+    inside a ``with lock:`` of the standard library, between the acquire and the block: the
+    lock then stays held. In a ``multiprocessing.Pool``'s result iterator that lock is one
+    the pool's result-handler thread needs, and the pool's ``terminate()`` waits for that
+    thread for ever (a sweep under test hung so on Ctrl-C). Here the interrupt is raised from
+    ``check()``, in the block's own code: an internal exception unwinds the block (cleanup
+    inside it, such as a pool's terminate(), runs still shielded), then the signal is raised
+    again (:func:`signal.raise_signal`) with the previous handlers back, so it becomes the
+    ``KeyboardInterrupt`` (or the command line's SIGTERM exception) the caller expects, or,
+    for a handler that returns, a ``KeyboardInterrupt``. A signal noted but not checked
+    before the block ends is delivered the same way at its end.
+
+    Only in the main thread and only for handlers set from Python and not ignored; elsewhere
+    ``check()`` does nothing and signals act as before. A process forked inside the block
+    (a pool's replacement worker) gets the default action. Callers must call ``check()``
+    often (a loop waiting with a timeout): a deferred Ctrl-C waits for it.
+    """
+    got: list[int] = []
+    owner = os.getpid()
+
+    def note(signum: int, frame: Any) -> None:
+        if os.getpid() != owner:  # a process forked inside the block (a pool's replacement
+            signal.signal(signum, signal.SIG_DFL)  # worker): the signal acts as by default,
+            os.kill(os.getpid(), signum)  # so a pool's terminate() still ends it
+            return
+        got.append(signum)
+
+    def check() -> None:
+        if got:
+            raise _Deferred()
+
+    saved = {}
+    if threading.current_thread() is threading.main_thread():
+        for s in INTERRUPTING:
+            if signal.getsignal(s) not in (None, signal.SIG_IGN):
+                saved[s] = signal.signal(s, note)
+    try:
+        yield check
+    except _Deferred:
+        pass
+    finally:
+        for s, previous in saved.items():
+            signal.signal(s, previous)
+    if got:
+        signal.raise_signal(got[0])  # its handler raises here, in this frame
+        raise KeyboardInterrupt()  # a handler that returned: the block was still cut short
+
+
+def raised_outside_numba(handler: Callable[[int, Any], Any]) -> Callable[[int, Any], Any]:
+    """``handler`` wrapped so that it never runs while Python is inside numba or llvmlite.
+
+    numba's loading and compiling of kernels is not safe against an exception raised at an
+    arbitrary bytecode: a ``KeyboardInterrupt`` landing in llvmlite's disposal of an LLVM
+    object (a finaliser, where Python drops it) or between numba's steps leaves the LLVM
+    state half done, and the process later died of a segmentation fault (a sweep given
+    Ctrl-C while loading a cached kernel, exit -11) or, in a pool worker, lost the exit it
+    was asked for and hung its pool. The wrapper looks at the interrupted frame and the
+    frames that called it; when one belongs to a package of :data:`NOT_INTERRUPTIBLE`, it
+    does nothing now and asks again :data:`RETRY_S` later (:func:`_thread.interrupt_main`,
+    which runs the signal's Python handler again), until the call has returned. A native
+    compile holds Python's signal handling anyway; the delay this adds is the Python part
+    of numba's work.
+    """
+    def outside(signum: int, frame: Any) -> Any:
+        f = frame
+        while f is not None:
+            if f.f_globals.get("__name__", "").partition(".")[0] in NOT_INTERRUPTIBLE:
+                again = threading.Timer(RETRY_S, _thread.interrupt_main, (signum,))
+                again.daemon = True
+                again.start()
+                return None
+            f = f.f_back
+        return handler(signum, frame)
+
+    outside.__wrapped__ = handler  # type: ignore[attr-defined]
+    return outside

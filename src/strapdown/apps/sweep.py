@@ -169,6 +169,8 @@ def _check_keys(where: str, got, allowed) -> None:
                          f"{', '.join(sorted(allowed))}")
 
 
+#: How often a local pool's parent looks for a deferred Ctrl-C while it waits (seconds).
+POLL_S = 0.1
 #: Largest scenario file read (bytes).
 MAX_SCENARIO_BYTES = 1024**2
 #: Most cases (grid points × algorithms) one scenario may have.
@@ -657,18 +659,34 @@ def _run_local(pending, workers, finish, bar) -> None:
     import multiprocessing
 
     from strapdown._core import compile_notice
+    from strapdown._core.signals import interrupts_deferred
 
     # Workers ignore Ctrl-C (the parent alone reports it) and carry the compile notice; on
-    # any exception, Ctrl-C included, leaving the block terminates them at once.
+    # any exception, Ctrl-C included, they are terminated at once. The parent's Ctrl-C and
+    # SIGTERM are deferred to between results, from after the workers are forked (they keep
+    # the command line's handlers) until they are gone: raised inside the pool's iterator,
+    # one could leave a lock held that terminate() then waits on for ever.
     ctx = multiprocessing.get_context()
     said = ctx.Value("b", 0)
     with ctx.Pool(workers, initializer=compile_notice.worker_initializer,
-                  initargs=(said, compile_notice.active())) as pool:
-        for i, row in pool.imap_unordered(_run_numbered, enumerate(pending)):
-            finish(pending[i], row)
-            bar.update()
-        pool.close()
-        pool.join()
+                  initargs=(said, compile_notice.active())) as pool, \
+            interrupts_deferred() as check:
+        try:
+            results = pool.imap_unordered(_run_numbered, enumerate(pending))
+            while True:
+                check()
+                try:
+                    i, row = results.next(timeout=POLL_S)
+                except multiprocessing.TimeoutError:
+                    continue
+                except StopIteration:
+                    break
+                finish(pending[i], row)
+                bar.update()
+            pool.close()
+            pool.join()
+        finally:
+            pool.terminate()  # done here, still deferred; the pool's exit repeats it (a no-op)
 
 
 def _run_numbered(item: tuple[int, Case]) -> tuple[int, dict]:

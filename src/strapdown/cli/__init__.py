@@ -22,8 +22,9 @@ import os
 import signal
 import sys
 import textwrap
+import threading
 
-from strapdown._core.signals import interrupts_kept, replaced_handlers
+from strapdown._core.signals import interrupts_kept, raised_outside_numba, replaced_handlers
 from strapdown.cli import (
     advise,
     ahrs,
@@ -50,6 +51,9 @@ EXIT_OK, EXIT_USAGE, EXIT_IO, EXIT_INTERRUPTED, EXIT_PIPE = 0, 2, 74, sweep.INTE
 #: An internal error (a bug; sysexits' EX_SOFTWARE) and SIGTERM (128 + 15, as a shell reports).
 EXIT_INTERNAL, EXIT_TERMINATED = 70, 128 + signal.SIGTERM
 
+#: How long a sweep's pool worker given SIGTERM has to exit by its SystemExit (releasing its
+#: locks) before it is ended by ``os._exit`` (seconds).
+WORKER_EXIT_GRACE_S = 1.0
 #: Where an internal error asks to be reported (with the command line).
 REPORT_TO = "the strapdown issue tracker"
 #: Longest message of an internal error (characters), so one line stays one line.
@@ -121,20 +125,33 @@ def main(argv: list[str] | None = None) -> int:
         # group's signal) must not interrupt the cleanup the first one started
         signal.signal(signal.SIGTERM, signal.SIG_IGN)
         if os.getpid() != owner:  # a forked pool worker (a sweep's): exit, quietly, releasing
-            raise SystemExit(EXIT_TERMINATED)  # its locks (the pool's queues) on the way out
+            # its locks (the pool's queues) on the way out; should the SystemExit land in a
+            # finaliser (llvmlite's, while numba loads a kernel), Python drops it, and the
+            # worker, deaf to SIGTERM from here on, would keep the pool's terminate() waiting
+            # for ever: a daemon thread ends it regardless, a moment later
+            later = threading.Timer(WORKER_EXIT_GRACE_S, os._exit, (EXIT_TERMINATED,))
+            later.daemon = True
+            later.start()
+            raise SystemExit(EXIT_TERMINATED)
         got.append(signum)
         raise Terminated()
 
+    # neither signal's exception is raised inside numba or llvmlite (a kernel loading or
+    # compiling): held back there, it comes once the call has returned
+    previous = {}
     try:
-        previous = signal.signal(signal.SIGTERM, on_sigterm)
+        previous[signal.SIGTERM] = signal.signal(signal.SIGTERM, raised_outside_numba(on_sigterm))
+        if signal.getsignal(signal.SIGINT) is signal.default_int_handler:  # not if ignored
+            previous[signal.SIGINT] = signal.signal(
+                signal.SIGINT, raised_outside_numba(signal.default_int_handler))
     except ValueError:  # not the main thread: signals stay as they are
-        previous = None
+        pass
     try:
         with interrupts_kept():  # Ctrl-C landing in a finaliser: delivered again, no traceback
             return _main(argv, got)
     finally:
-        if previous is not None:
-            signal.signal(signal.SIGTERM, previous)
+        for s, handler in previous.items():
+            signal.signal(s, handler)
 
 
 def _main(argv: list[str] | None, got: list[int]) -> int:
