@@ -9,7 +9,9 @@ Run from the repository (``make fuzz`` runs the long profile)::
 Every run is under a memory cap (``RLIMIT_AS`` of :data:`MEMORY_CAP` set in the child) and
 a time limit (killed after :data:`KILL_AFTER` s). A run fails the campaign when it ends in
 an exception other than :class:`strapdown.InputError` (API), a traceback, a signal or an
-exit status other than 0, 2 and 3 (command line), takes over :data:`TIME_LIMIT` s, peaks
+exit status other than 0, 2 and 3 (command line), takes over :data:`TIME_LIMIT` s (the API's
+kernels are compiled before any timing; a command line's first run over it, which may have
+compiled, is judged by a second run), peaks
 over :data:`PEAK_LIMIT_MB` MB of resident memory (the process's own high-water mark,
 ``VmHWM``, not ``ru_maxrss``, which counts the parent's RSS at fork; for the API the worker's
 mark, an upper bound of each input's own peak; a worker over it is restarted), leaves a
@@ -405,6 +407,7 @@ def _api(items: list[Input], workers: int, tallies: dict[str, Tally], say) -> No
 def _cli(items: list[Input], per_format: int, tallies: dict[str, Tally], scratch: Path,
          rng: np.random.Generator) -> None:
     by_fmt: dict[str, list[Input]] = defaultdict(list)
+    timed: set[tuple[str, ...]] = set()  # the command lines run once already
     for i in items:
         by_fmt[i.fmt].append(i)
     for fmt, group in by_fmt.items():
@@ -421,6 +424,14 @@ def _cli(items: list[Input], per_format: int, tallies: dict[str, Tally], scratch
             d = scratch / f"cli-{fmt}-{k}"
             d.mkdir(parents=True)
             rec = run_cli(args, inp.path, d)
+            if rec["seconds"] > TIME_LIMIT and tuple(args) not in timed:
+                # a command's first run may compile kernels no API target needed (a fresh
+                # clone's `nav`: 12 CPU-s): it is run again, and the second run is judged
+                # (a slow input stays slow; the compile is cached by then)
+                shutil.rmtree(d, ignore_errors=True)
+                d.mkdir(parents=True)
+                rec = run_cli(args, inp.path, d)
+            timed.add(tuple(args))
             shutil.rmtree(d, ignore_errors=True)
             t.cli_runs += 1
             t.measure(inp, rec)
