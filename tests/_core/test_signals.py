@@ -171,6 +171,28 @@ def test_an_interrupt_inside_numba_or_llvmlite_comes_once_the_call_has_returned(
     assert log == ["returned", "outside"]
 
 
+_INSIDE_THEN_BLOCK = """
+def inside():
+    signal.raise_signal(signal.SIGINT)
+"""
+
+
+def test_an_interrupt_held_back_reaches_a_process_blocked_in_a_system_call():
+    """After the numba call the main thread blocks (a pool worker waiting for its queue's
+    lock): the interrupt sent again must wake it, not wait for the block to end."""
+    ns = {"__name__": "numba.core.dispatcher", "signal": signal}
+    exec(_INSIDE_THEN_BLOCK, ns)
+    held = threading.Lock()
+    held.acquire()
+    with replaced_handlers(raised_outside_numba(signal.default_int_handler)):
+        with pytest.raises(KeyboardInterrupt):
+            ns["inside"]()
+            start = time.monotonic()
+            held.acquire(timeout=20)  # never released: only the interrupt ends the wait
+    # woken (~RETRY_S), not run once the wait timed out (as _thread.interrupt_main would)
+    assert time.monotonic() - start < 10
+
+
 def test_an_interrupt_outside_numba_is_raised_at_once():
     with replaced_handlers(raised_outside_numba(signal.default_int_handler)):
         with pytest.raises(KeyboardInterrupt):

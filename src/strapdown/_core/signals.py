@@ -154,16 +154,19 @@ def raised_outside_numba(handler: Callable[[int, Any], Any]) -> Callable[[int, A
     Ctrl-C while loading a cached kernel, exit -11) or, in a pool worker, lost the exit it
     was asked for and hung its pool. The wrapper looks at the interrupted frame and the
     frames that called it; when one belongs to a package of :data:`NOT_INTERRUPTIBLE`, it
-    does nothing now and asks again :data:`RETRY_S` later (:func:`_thread.interrupt_main`,
-    which runs the signal's Python handler again), until the call has returned. A native
-    compile holds Python's signal handling anyway; the delay this adds is the Python part
-    of numba's work.
+    does nothing now and sends the signal again :data:`RETRY_S` later, until the call has
+    returned. A native compile holds Python's signal handling anyway; the delay this adds is
+    the Python part of numba's work. The signal sent again is a real one, to the main thread
+    (:func:`signal.pthread_kill`), not :func:`_thread.interrupt_main`: that only marks the
+    handler as due, and a process that meanwhile blocked in a system call (a pool worker
+    waiting for its queue's lock) would never run it and hung its pool's terminate().
     """
     def outside(signum: int, frame: Any) -> Any:
         f = frame
         while f is not None:
             if f.f_globals.get("__name__", "").partition(".")[0] in NOT_INTERRUPTIBLE:
-                again = threading.Timer(RETRY_S, _thread.interrupt_main, (signum,))
+                main = threading.get_ident()  # handlers run in the main thread
+                again = threading.Timer(RETRY_S, signal.pthread_kill, (main, signum))
                 again.daemon = True
                 again.start()
                 return None
