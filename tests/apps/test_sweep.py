@@ -177,6 +177,30 @@ def test_ctrl_c_stops_sweep_with_one_line_and_status_130(tmp_path, workers):
         os.killpg(proc.pid, 0)
 
 
+def _deaf_to_sigterm() -> None:
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
+
+
+def test_a_pool_worker_that_ignores_sigterm_is_killed_not_waited_for():
+    """sweep._terminate: pool.terminate() alone waits for ever on a worker SIGTERM does not
+    end (seen under test: a worker blocked on its queue's lock, the signal never handled)."""
+    import multiprocessing
+    import threading
+
+    from strapdown.apps.sweep import _terminate
+
+    ctx = multiprocessing.get_context("fork")
+    pool = ctx.Pool(1, initializer=_deaf_to_sigterm)
+    pool.apply_async(time.sleep, (0.05,)).get(timeout=30)  # the worker is up
+    pool.apply_async(time.sleep, (600,))  # and busy: it will not read the pool's sentinel
+    time.sleep(0.2)
+    th = threading.Thread(target=_terminate, args=(pool, ctx), daemon=True)
+    th.start()
+    th.join(timeout=60)
+    assert not th.is_alive(), "the pool's terminate() still waits for its worker"
+    assert ctx.active_children() == []
+
+
 def test_cli_sweep_status_lines_printed_once(tmp_path, capsys):
     from strapdown.cli import main
 

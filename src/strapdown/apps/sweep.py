@@ -69,6 +69,7 @@ import json
 import math
 import os
 import sys
+import threading
 import tomllib
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
@@ -171,6 +172,8 @@ def _check_keys(where: str, got, allowed) -> None:
 
 #: How often a local pool's parent looks for a deferred Ctrl-C while it waits (seconds).
 POLL_S = 0.1
+#: How long a local pool's workers have to end on SIGTERM before they are killed (seconds).
+KILL_AFTER_S = 3.0
 #: Largest scenario file read (bytes).
 MAX_SCENARIO_BYTES = 1024**2
 #: Most cases (grid points × algorithms) one scenario may have.
@@ -686,7 +689,24 @@ def _run_local(pending, workers, finish, bar) -> None:
             pool.close()
             pool.join()
         finally:
-            pool.terminate()  # done here, still deferred; the pool's exit repeats it (a no-op)
+            _terminate(pool, ctx)  # done here, still deferred; the pool's exit repeats it
+
+
+def _terminate(pool, ctx) -> None:
+    """``pool.terminate()``, with any worker still alive :data:`KILL_AFTER_S` later killed.
+
+    terminate() sends each worker SIGTERM and waits for it without a limit. A worker may not
+    end on it: under test, one in ~30 interrupted sweeps kept a worker blocked on its
+    queue's lock with SIGTERM never handled, and the sweep hung. SIGKILL cannot be missed.
+    """
+    workers = [p for p in ctx.active_children() if p.is_alive()]
+    guard = threading.Timer(KILL_AFTER_S, lambda: [p.kill() for p in workers if p.is_alive()])
+    guard.daemon = True
+    guard.start()
+    try:
+        pool.terminate()
+    finally:
+        guard.cancel()
 
 
 def _run_numbered(item: tuple[int, Case]) -> tuple[int, dict]:
