@@ -1,6 +1,6 @@
 """The command line's interrupting signals (Ctrl-C's SIGINT, SIGTERM) handled differently
 for the length of a block (:func:`replaced_handlers`), and never lost in a finaliser
-(:func:`interrupts_kept`), never acted on inside numba or llvmlite (:func:`raised_outside_numba`),
+(:func:`interrupts_kept`), never acted on inside llvmlite (:class:`OutsideLlvmlite`),
 or held back until the code asks (:func:`interrupts_deferred`)."""
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ import threading
 from collections.abc import Callable, Iterator
 from typing import Any
 
-__all__ = ["INTERRUPTING", "interrupts_deferred", "interrupts_kept", "raised_outside_numba",
+__all__ = ["INTERRUPTING", "OutsideLlvmlite", "interrupts_deferred", "interrupts_kept",
            "replaced_handlers"]
 
 #: The signals the command line turns into an exception (``KeyboardInterrupt``).
@@ -23,10 +23,10 @@ INTERRUPTING = (signal.SIGINT, signal.SIGTERM)
 #: How long after an interrupt lost in a finaliser it is raised again (:func:`interrupts_kept`).
 REDELIVERY_DELAY_S = 1e-3
 #: The top-level packages whose Python code a signal's exception is never raised in
-#: (:func:`raised_outside_numba`).
-NOT_INTERRUPTIBLE = ("numba", "llvmlite")
-#: How often a signal held back by :func:`raised_outside_numba` is tried again (seconds).
-RETRY_S = 0.01
+#: (:class:`OutsideLlvmlite`).
+NOT_INTERRUPTIBLE = ("llvmlite",)
+#: How soon a signal held back by :class:`OutsideLlvmlite` is sent again (seconds).
+RETRY_S = 1e-3
 
 
 @contextlib.contextmanager
@@ -144,34 +144,47 @@ def interrupts_deferred() -> Iterator[Callable[[], None]]:
         raise KeyboardInterrupt()  # a handler that returned: the block was still cut short
 
 
-def raised_outside_numba(handler: Callable[[int, Any], Any]) -> Callable[[int, Any], Any]:
-    """``handler`` wrapped so that it never runs while Python is inside numba or llvmlite.
+class OutsideLlvmlite:
+    """A signal handler that never runs while Python is inside llvmlite; ``settle()`` runs
+    one that is still held back.
 
-    numba's loading and compiling of kernels is not safe against an exception raised at an
-    arbitrary bytecode: a ``KeyboardInterrupt`` landing in llvmlite's disposal of an LLVM
-    object (a finaliser, where Python drops it) or between numba's steps leaves the LLVM
-    state half done, and the process later died of a segmentation fault (a sweep given
-    Ctrl-C while loading a cached kernel, exit -11) or, in a pool worker, lost the exit it
-    was asked for and hung its pool. The wrapper looks at the interrupted frame and the
-    frames that called it; when one belongs to a package of :data:`NOT_INTERRUPTIBLE`, it
-    does nothing now and sends the signal again :data:`RETRY_S` later, until the call has
-    returned. A native compile holds Python's signal handling anyway; the delay this adds is
-    the Python part of numba's work. The signal sent again is a real one, to the main thread
-    (:func:`signal.pthread_kill`), not :func:`_thread.interrupt_main`: that only marks the
-    handler as due, and a process that meanwhile blocked in a system call (a pool worker
-    waiting for its queue's lock) would never run it and hung its pool's terminate().
+    numba builds and loads kernels through llvmlite, whose disposal of LLVM objects (often
+    a finaliser) is not safe against an exception raised at an arbitrary bytecode: a
+    ``KeyboardInterrupt`` landing there is dropped by Python (a finaliser's exception) and
+    leaves the object half disposed; the process then died of a segmentation fault at the
+    next kernel it loaded (a sweep given Ctrl-C with ``--workers 1``, exit -11), or, in a
+    pool worker, lost the exit it was asked for. When the interrupted frame or one that
+    called it belongs to a package of :data:`NOT_INTERRUPTIBLE`, this does nothing now and
+    sends the signal again :data:`RETRY_S` later, as a real signal to the main thread
+    (:func:`signal.pthread_kill`; :func:`_thread.interrupt_main` only marks the handler as
+    due, and a process blocked in a system call meanwhile would never run it). numba's own
+    Python code is interrupted as before (Ctrl-C during a compile stops it at once).
+
+    A signal still held back when the program is about to end would be lost with the
+    retry's daemon thread: the caller runs :meth:`settle` at its end, which runs the handler
+    for it then (as if the signal had come just after the work finished).
     """
-    def outside(signum: int, frame: Any) -> Any:
+
+    def __init__(self, handler: Callable[[int, Any], Any]) -> None:
+        self.handler = handler
+        self.pending: int | None = None
+
+    def __call__(self, signum: int, frame: Any) -> Any:
         f = frame
         while f is not None:
             if f.f_globals.get("__name__", "").partition(".")[0] in NOT_INTERRUPTIBLE:
+                self.pending = signum
                 main = threading.get_ident()  # handlers run in the main thread
                 again = threading.Timer(RETRY_S, signal.pthread_kill, (main, signum))
                 again.daemon = True
                 again.start()
                 return None
             f = f.f_back
-        return handler(signum, frame)
+        self.pending = None
+        return self.handler(signum, frame)
 
-    outside.__wrapped__ = handler  # type: ignore[attr-defined]
-    return outside
+    def settle(self) -> None:
+        """Run the handler for a signal still held back (it raises, as a rule)."""
+        if self.pending is not None:
+            signum, self.pending = self.pending, None
+            self.handler(signum, None)

@@ -24,7 +24,7 @@ import sys
 import textwrap
 import threading
 
-from strapdown._core.signals import interrupts_kept, raised_outside_numba, replaced_handlers
+from strapdown._core.signals import OutsideLlvmlite, interrupts_kept, replaced_handlers
 from strapdown.cli import (
     advise,
     ahrs,
@@ -136,26 +136,28 @@ def main(argv: list[str] | None = None) -> int:
         got.append(signum)
         raise Terminated()
 
-    # neither signal's exception is raised inside numba or llvmlite (a kernel loading or
-    # compiling): held back there, it comes once the call has returned
+    # neither signal's exception is raised inside llvmlite (numba loading or compiling a
+    # kernel): held back there, it comes a moment later, or at the latest at the end
+    guards = {signal.SIGTERM: OutsideLlvmlite(on_sigterm)}
     previous = {}
     try:
-        previous[signal.SIGTERM] = signal.signal(signal.SIGTERM, raised_outside_numba(on_sigterm))
         if signal.getsignal(signal.SIGINT) is signal.default_int_handler:  # not if ignored
-            previous[signal.SIGINT] = signal.signal(
-                signal.SIGINT, raised_outside_numba(signal.default_int_handler))
+            guards[signal.SIGINT] = OutsideLlvmlite(signal.default_int_handler)
+        for s, guard in guards.items():
+            previous[s] = signal.signal(s, guard)
     except ValueError:  # not the main thread: signals stay as they are
-        pass
+        guards = {}
     try:
         with interrupts_kept():  # Ctrl-C landing in a finaliser: delivered again, no traceback
-            return _main(argv, got)
+            return _main(argv, got, list(guards.values()))
     finally:
         for s, handler in previous.items():
             signal.signal(s, handler)
 
 
-def _main(argv: list[str] | None, got: list[int]) -> int:
-    """:func:`main` once the SIGTERM handler is in place; ``got`` lists the signals received."""
+def _main(argv: list[str] | None, got: list[int], guards: list[OutsideLlvmlite]) -> int:
+    """:func:`main` once the signal handlers are in place; ``got`` lists the signals
+    received; a signal ``guards`` still hold back when the command is done is raised then."""
     prog = "strapdown"
     try:
         parser = build_parser()
@@ -165,11 +167,15 @@ def _main(argv: list[str] | None, got: list[int]) -> int:
 
         with memory_budget(getattr(args, "max_memory", None)):  # --max-memory, where it is
             if args.command in _NO_KERNELS:
-                return args.handler(args)
-            from strapdown._core.compile_notice import notice
+                status = args.handler(args)
+            else:
+                from strapdown._core.compile_notice import notice
 
-            with notice(say):
-                return args.handler(args)
+                with notice(say):
+                    status = args.handler(args)
+        for guard in guards:
+            guard.settle()
+        return status
     except ValueError as exc:
         _exit(EXIT_USAGE, f"{prog}: error: {exc}\n")
     except KeyboardInterrupt as exc:  # a sweep's says how far it got
