@@ -127,7 +127,7 @@ def test_simulated_equals_library(tmp_path, algorithm, changes, mag):
     h = check_rate_record(t, gyro, min_samples=4).td
     for real in ("double", "float"):
         e, lib = build(tmp_path, h=h, real=real, mag=mag, algorithm=algorithm, config=cfg,
-                       name=f"sim_{real}")
+                       name=f"sim_{real}", opt="-O1")  # 28 modules; -O2: the BROAD ones
         q, rc, fl = run(e, lib, gyro, acc, m if mag else None)
         err = _compare(res, q, rc, fl, e.init_samples)
         if real == "double":
