@@ -154,6 +154,14 @@ def test_without_a_signal_the_check_does_nothing_and_ignored_signals_stay_ignore
             check()
 
 
+def _defined_in(module: str, source: str, **names):
+    """The function ``inside`` of ``source``, its code belonging to ``module`` (as if
+    llvmlite's own), with ``names`` as its globals."""
+    ns = {"__name__": module, "signal": signal, "time": time, **names}
+    exec(source, ns)
+    return ns["inside"]
+
+
 _INSIDE = """
 def inside(log):
     signal.raise_signal(signal.SIGINT)
@@ -166,12 +174,11 @@ def inside(log):
 
 @pytest.mark.parametrize("module", ["llvmlite.binding.ffi", "llvmlite.binding.module"])
 def test_an_interrupt_inside_llvmlite_comes_once_the_call_has_returned(module):
-    ns = {"__name__": module, "signal": signal, "time": time}
-    exec(_INSIDE, ns)  # a function whose code belongs to that module
+    inside = _defined_in(module, _INSIDE)
     log = []
     with replaced_handlers(OutsideLlvmlite(signal.default_int_handler)):
         with pytest.raises(KeyboardInterrupt):
-            ns["inside"](log)
+            inside(log)
             log.append("outside")
             deadline = time.monotonic() + 5
             while time.monotonic() < deadline:  # the interrupt arrives here, retried
@@ -188,13 +195,12 @@ def inside():
 def test_an_interrupt_held_back_reaches_a_process_blocked_in_a_system_call():
     """After the llvmlite call the main thread blocks (a pool worker waiting for its queue's
     lock): the interrupt sent again must wake it, not wait for the block to end."""
-    ns = {"__name__": "llvmlite.binding.ffi", "signal": signal}
-    exec(_INSIDE_THEN_BLOCK, ns)
+    inside = _defined_in("llvmlite.binding.ffi", _INSIDE_THEN_BLOCK)
     held = threading.Lock()
     held.acquire()
     with replaced_handlers(OutsideLlvmlite(signal.default_int_handler)):
         with pytest.raises(KeyboardInterrupt):
-            ns["inside"]()
+            inside()
             start = time.monotonic()
             held.acquire(timeout=20)  # never released: only the interrupt ends the wait
     # woken (~RETRY_S), not run once the wait timed out (as _thread.interrupt_main would)
@@ -211,9 +217,10 @@ def test_a_signal_still_held_back_at_the_end_is_run_by_settle(monkeypatch):
     """The program ends within RETRY_S of a signal held back in llvmlite: settle() runs it."""
     monkeypatch.setattr(signal, "pthread_kill", lambda *args: None)  # the retry never comes
     guard = OutsideLlvmlite(signal.default_int_handler)
-    ns = {"__name__": "llvmlite.binding.ffi", "guard": guard, "signal": signal}
-    exec("def inside():\n    guard(signal.SIGINT, __import__('sys')._getframe())\n", ns)
-    ns["inside"]()  # held back
+    inside = _defined_in("llvmlite.binding.ffi",
+                         "def inside():\n    guard(signal.SIGINT, sys._getframe())\n",
+                         guard=guard, sys=sys)
+    inside()  # held back
     assert guard.pending == signal.SIGINT
     with pytest.raises(KeyboardInterrupt):
         guard.settle()

@@ -14,7 +14,7 @@ import threading
 from collections.abc import Callable, Iterator
 from typing import Any
 
-__all__ = ["INTERRUPTING", "OutsideLlvmlite", "interrupts_deferred", "interrupts_kept",
+__all__ = ["INTERRUPTING", "OutsideLlvmlite", "after", "interrupts_deferred", "interrupts_kept",
            "replaced_handlers"]
 
 #: The signals the command line turns into an exception (``KeyboardInterrupt``).
@@ -27,6 +27,15 @@ REDELIVERY_DELAY_S = 1e-3
 NOT_INTERRUPTIBLE = ("llvmlite",)
 #: How soon a signal held back by :class:`OutsideLlvmlite` is sent again (seconds).
 RETRY_S = 1e-3
+
+
+def after(delay_s: float, call: Callable[..., Any], *args: Any) -> threading.Timer:
+    """``call(*args)`` in ``delay_s`` seconds, from a daemon thread (started; ``cancel()``
+    it to drop the call). A daemon: it never keeps a process alive that is done."""
+    timer = threading.Timer(delay_s, call, args)
+    timer.daemon = True
+    timer.start()
+    return timer
 
 
 @contextlib.contextmanager
@@ -70,9 +79,7 @@ def interrupts_kept() -> Iterator[None]:
         if isinstance(unraisable.exc_value, KeyboardInterrupt):
             while True:
                 try:
-                    again = threading.Timer(REDELIVERY_DELAY_S, _thread.interrupt_main)
-                    again.daemon = True
-                    again.start()
+                    after(REDELIVERY_DELAY_S, _thread.interrupt_main)
                     return
                 except KeyboardInterrupt:  # the redelivery landed in this hook (a loaded
                     continue  # machine starts the thread slowly): Python would drop it too
@@ -99,8 +106,8 @@ def interrupts_deferred() -> Iterator[Callable[[], None]]:
     Python raises Ctrl-C's ``KeyboardInterrupt`` at whatever bytecode runs next, which may be
     inside a ``with lock:`` of the standard library, between the acquire and the block: the
     lock then stays held. In a ``multiprocessing.Pool``'s result iterator that lock is one
-    the pool's result-handler thread needs, and the pool's ``terminate()`` waits for that
-    thread for ever (a sweep under test hung so on Ctrl-C). Here the interrupt is raised from
+    the pool's result-handler thread needs, and the pool's ``terminate()`` would wait for
+    that thread for ever. Here the interrupt is raised from
     ``check()``, in the block's own code: an internal exception unwinds the block (cleanup
     inside it, such as a pool's terminate(), runs still shielded), then the signal is raised
     again (:func:`signal.raise_signal`) with the previous handlers back, so it becomes the
@@ -174,10 +181,8 @@ class OutsideLlvmlite:
         while f is not None:
             if f.f_globals.get("__name__", "").partition(".")[0] in NOT_INTERRUPTIBLE:
                 self.pending = signum
-                main = threading.get_ident()  # handlers run in the main thread
-                again = threading.Timer(RETRY_S, signal.pthread_kill, (main, signum))
-                again.daemon = True
-                again.start()
+                # handlers run in the main thread: get_ident() is the thread to send it to
+                after(RETRY_S, signal.pthread_kill, threading.get_ident(), signum)
                 return None
             f = f.f_back
         self.pending = None

@@ -22,7 +22,6 @@ import os
 import signal
 import sys
 import textwrap
-import threading
 
 from strapdown._core.signals import OutsideLlvmlite, interrupts_kept, replaced_handlers
 from strapdown.cli import (
@@ -51,9 +50,6 @@ EXIT_OK, EXIT_USAGE, EXIT_IO, EXIT_INTERRUPTED, EXIT_PIPE = 0, 2, 74, sweep.INTE
 #: An internal error (a bug; sysexits' EX_SOFTWARE) and SIGTERM (128 + 15, as a shell reports).
 EXIT_INTERNAL, EXIT_TERMINATED = 70, 128 + signal.SIGTERM
 
-#: How long a sweep's pool worker given SIGTERM has to exit by its SystemExit (releasing its
-#: locks) before it is ended by ``os._exit`` (seconds).
-WORKER_EXIT_GRACE_S = 1.0
 #: Where an internal error asks to be reported (with the command line).
 REPORT_TO = "the strapdown issue tracker"
 #: Longest message of an internal error (characters), so one line stays one line.
@@ -125,13 +121,8 @@ def main(argv: list[str] | None = None) -> int:
         # group's signal) must not interrupt the cleanup the first one started
         signal.signal(signal.SIGTERM, signal.SIG_IGN)
         if os.getpid() != owner:  # a forked pool worker (a sweep's): exit, quietly, releasing
-            # its locks (the pool's queues) on the way out; should the SystemExit land in a
-            # finaliser (llvmlite's, while numba loads a kernel), Python drops it, and the
-            # worker, deaf to SIGTERM from here on, would keep the pool's terminate() waiting
-            # for ever: a daemon thread ends it regardless, a moment later
-            later = threading.Timer(WORKER_EXIT_GRACE_S, os._exit, (EXIT_TERMINATED,))
-            later.daemon = True
-            later.start()
+            # its locks (the pool's queues) on the way out (should a finaliser drop it, the
+            # sweep kills the worker: apps.sweep._terminate)
             raise SystemExit(EXIT_TERMINATED)
         got.append(signum)
         raise Terminated()
