@@ -104,15 +104,16 @@ OPTIONS = [
     ("rk4", {}, True),
     ("rate-single", {"acc_model": "raw"}, True),
     ("rate-single", {"estimate_acc_bias": True}, True),
-    ("rate-single", {"acc_model": "raw", "estimate_acc_bias": True, "acc_gate_mode": "soft"},
-     True),
+    ("rate-single", {"acc_model": "raw", "estimate_acc_bias": True, "acc_gate_mode": "soft",
+                     "acc_sample": "point"}, True),
     ("rate-single", {"gyro_sample": "point", "latency_s": 0.01}, True),
     ("rate-single", {"gating": False, "declination_deg": 12.5}, True),
     ("rate-single", {"estimate_mag_delay": False, "mag_delay_s": 0.02,
                      "mag_disturbed_power": 1.0, "heading_rate_noise": 1e-3}, True),
     ("rate-single", {"rest_update": False, "use_accelerometer": False}, True),
-    # issue 25's kernel: the motion-acceleration weight, and field samples not turned
-    ("rate-single", {"acc_motion_leak": 0.5}, True),
+    # issue 25's kernel: the motion-acceleration weight (with point accelerometer samples,
+    # turned back half a period), and field samples not turned
+    ("rate-single", {"acc_motion_leak": 0.5, "acc_sample": "point"}, True),
     ("rate-single", {"acc_motion_leak": 0.3, "estimate_acc_bias": True, "mag_sample": "interval"},
      True),
 ]

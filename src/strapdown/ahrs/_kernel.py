@@ -220,6 +220,7 @@ class Params(NamedTuple):
     heading_bridge_noise: bool  #: AhrsConfig.heading_bridge_noise
     meas_lead: float  #: how far the magnetometer's samples lead the attitude they update, s
     #: (half a period for point field samples beside interval gyro samples; :func:`_at_state_time`)
+    acc_lead: float  #: the same for the accelerometer's samples, s (``AhrsConfig.acc_sample``)
     hi_on: bool  #: estimate a hard iron online (:func:`_hard_iron_span`)
     hi_span: int  #: its span, epochs
     hi_forget: float  #: its sums' forgetting factor per span
@@ -955,11 +956,12 @@ def _delayed_field(ringC, j, mk, mn):
 
 @njit(cache=True, inline="always", error_model="numpy")
 def _at_state_time(v, k, x, h, is_rate, bias, lead, out):
-    """Stage 6: a body-frame sample ``v`` of a fixed reference-frame vector (the field)
-    taken at sample k's stamp, as it was ``lead`` seconds earlier — when the filter's
-    attitude refers (``Params.meas_lead``: half a period for a field sampled at the stamp
-    beside interval gyro samples, whose attitude refers to the middle of the sample
-    period, as does the accelerometer's mean): ``v(t − δ) = exp(δ[ω×]) v(t)`` to second
+    """Stages 5 and 6: a body-frame sample ``v`` of a fixed reference-frame vector (the
+    field; gravity's part of the specific force) taken at sample k's stamp, as it was
+    ``lead`` seconds earlier — when the filter's attitude refers (``Params.meas_lead``,
+    ``Params.acc_lead``: half a period for a sample taken at the stamp beside interval gyro
+    samples, whose attitude refers to the middle of the sample period, as does an interval
+    accelerometer sample): ``v(t − δ) = exp(δ[ω×]) v(t)`` to second
     order, ω the bias-corrected rate of sample k. Without it a body spinning at ω sees
     its field turned by ωδ against the attitude — 0.67° at 9.4 rad/s and 400 Hz, a
     steady heading error."""
@@ -1367,6 +1369,7 @@ def ekf_kernel(sensors, prop, window, params, init, out):
     dx = np.zeros(nx)
     fk = np.empty(3)
     mk = np.empty(3)
+    fa = np.empty(3)
     fn = np.zeros(3)
     lp = np.zeros(3)
     lp_s0 = np.zeros(3)
@@ -1488,6 +1491,10 @@ def ekf_kernel(sensors, prop, window, params, init, out):
         if params.use_accelerometer:
             for a in range(3):
                 fk[a] = acc[k, a] - acc_bias[a]
+            if params.acc_lead > 0.0:  # a point sample, turned back to the state's time
+                _at_state_time(fk, k, x, h, is_rate, bias, params.acc_lead, fa)
+                for a in range(3):
+                    fk[a] = fa[a]
             force = _recovery_due(params.gating, acc_quiet, acc_bad_since, tk,
                                   params.recover_acc_s)
             if force:

@@ -77,6 +77,11 @@ def _arguments(p: argparse.ArgumentParser) -> None:
                    help="what a gyro sample is: the mean rate over the period ending at its "
                    "stamp (interval: MEMS IMUs, VQF's convention; each output predicted half a "
                    "period ahead) or the rate at the stamp (point: exact simulations)")
+    p.add_argument("--acc-sample", choices=["interval", "point"], default="interval",
+                   help="what an accelerometer sample is, beside interval gyro samples: a "
+                   "mean like the gyro's (interval: gyro and accelerometer through one "
+                   "decimation filter; the default) or the specific force at its stamp "
+                   "(point: exact simulations, VQF's convention; turned back half a period)")
     p.add_argument("--mag-sample", choices=["point", "interval"], default="point",
                    help="what a magnetometer sample is, beside interval gyro samples: the "
                    "field at its stamp (point: a magnetometer read at an instant; turned back "
@@ -102,7 +107,8 @@ def run(args: argparse.Namespace) -> int:
         raise InputError(f"--declination-deg must lie within ±{MAX_DECLINATION_DEG:g}° (east "
                          f"positive), got {args.declination_deg:g}")
     cfg = AhrsConfig(gating=not args.no_gating, declination_deg=args.declination_deg,
-                     gyro_sample=args.gyro_sample, mag_sample=args.mag_sample)
+                     gyro_sample=args.gyro_sample, acc_sample=args.acc_sample,
+                     mag_sample=args.mag_sample)
     show = progress(args)
     if show:
         say(f"filtering {args.imu} ({args.algorithm}"
