@@ -1,7 +1,7 @@
 """The AHRS generalisation suite over several seeds: our filter and VQF on simulated recordings.
 
-Usage: ``python benchmarks/ahrs_generalisation.py [--seeds 0 1 2 3 4] [--aligned] [--out
-reports/ahrs_generalisation.json]``.
+Usage: ``python benchmarks/ahrs_generalisation.py [--seeds 0 1 2 3 4] [--aligned]
+[--hard-iron F --soft-iron F] [--out reports/ahrs_generalisation.json]``.
 
 Each seed draws the sensor errors and the random parts of the motions
 (:func:`strapdown.truth.scenarios.suite`, :func:`~strapdown.truth.scenarios.record`); each
@@ -12,11 +12,17 @@ constant world and body rotation to each estimate instead (the metric of the iss
 recordings). Prints, per scenario, the mean over
 the seeds of total / inclination RMSE and the geometric mean of ours/VQF (total), and the
 worst seed's ratio; ``strapdown benchmark-ahrs --suite generalisation`` is one seed of it.
+
+``--hard-iron F --soft-iron F`` gives every filter an uncalibrated magnetometer instead
+(:func:`uncalibrated`): the recorded field ``m`` becomes ``S m + F_h |m|_med d``, ``d`` a
+random unit vector in the body, ``S = I + F_s U``, ``U`` uniform in (−1, 1) per entry, drawn
+per seed and recording (docs/reproductions.md, "A magnetometer that is not calibrated").
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import sys
 from pathlib import Path
@@ -24,9 +30,21 @@ from pathlib import Path
 import numpy as np
 
 from strapdown.apps.ahrs_generalisation import FILTERS, evaluate
-from strapdown.truth.scenarios import suite
+from strapdown.truth.scenarios import SimulatedRecording, suite
 
 _PAIRS = (("strapdown EKF", "VQF"), ("strapdown EKF offline", "offlineVQF"))
+
+
+def uncalibrated(rec: SimulatedRecording, hard: float, soft: float,
+                 rng: np.random.Generator) -> SimulatedRecording:
+    """``rec`` with its recorded field ``m`` (noise included) turned into ``S m + b``: ``b``
+    of ``hard`` times the median of ``|m|`` along a random body direction, ``S = I + soft U``
+    with ``U`` uniform in (−1, 1) per entry."""
+    d = rng.standard_normal(3)
+    d /= np.linalg.norm(d)
+    S = np.eye(3) + soft * rng.uniform(-1.0, 1.0, (3, 3))
+    b = hard * float(np.median(np.linalg.norm(rec.mag, axis=1))) * d
+    return dataclasses.replace(rec, mag=rec.mag @ S.T + b)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -34,6 +52,10 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2, 3, 4])
     ap.add_argument("--aligned", action="store_true",
                     help="score after fitting a constant world and body rotation")
+    ap.add_argument("--hard-iron", type=float, default=0.0,
+                    help="a hard-iron offset, a fraction of the field's norm (e.g. 0.3)")
+    ap.add_argument("--soft-iron", type=float, default=0.0,
+                    help="soft-iron scaling: entries of S - I uniform within ± this (e.g. 0.1)")
     ap.add_argument("--out", default=None, help="write every figure as JSON here")
     args = ap.parse_args(argv)
     per_seed = {}
@@ -42,7 +64,12 @@ def main(argv: list[str] | None = None) -> int:
         print(f"seed {seed}", file=sys.stderr)
         scenarios = suite(seed)
         names = [s.name for s in scenarios]
-        per_seed[seed] = evaluate(scenarios, seed=seed, aligned=args.aligned)
+        alter = None
+        if args.hard_iron or args.soft_iron:
+            def alter(rec, k, seed=seed):
+                rng = np.random.default_rng(1000 + 17 * seed + k)
+                return uncalibrated(rec, args.hard_iron, args.soft_iron, rng)
+        per_seed[seed] = evaluate(scenarios, seed=seed, aligned=args.aligned, alter=alter)
     header = ["scenario", *FILTERS, "ours/VQF causal (worst)", "ours/VQF offline (worst)"]
     print("| " + " | ".join(header) + " |\n|" + "---|" * len(header))
     record = []
@@ -65,6 +92,9 @@ def main(argv: list[str] | None = None) -> int:
               else "BROAD's metric")
     print(f"\ncells: mean over seeds {args.seeds} of total / inclination RMSE (°, {metric}, "
           "from 5 s); ratios: geometric mean over the seeds (worst seed)")
+    if args.hard_iron or args.soft_iron:
+        print(f"magnetometer uncalibrated: hard iron {args.hard_iron:g} of the field's norm, "
+              f"soft iron ±{args.soft_iron:g}")
     if args.out:
         Path(args.out).parent.mkdir(parents=True, exist_ok=True)
         Path(args.out).write_text(json.dumps({"seeds": args.seeds, "scenarios": record},

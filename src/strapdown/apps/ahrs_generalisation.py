@@ -53,14 +53,18 @@ def trial(rec: SimulatedRecording, settle_s: float = SETTLE_S) -> BroadTrial:
 
 def evaluate(scenarios: Sequence[Scenario] | None = None, *, seed: int = 0,
              duration_s: float | None = None, filters: Sequence[FilterName] = FILTERS,
-             progress: Callable[[str], None] | None = None, aligned: bool = False) -> dict:
+             progress: Callable[[str], None] | None = None, aligned: bool = False,
+             alter: Callable[[SimulatedRecording, int], SimulatedRecording] | None = None
+             ) -> dict:
     """Each filter on each scenario: ``{(scenario, filter): broad_errors(...)}``.
 
     ``duration_s`` shortens every recording (e.g. :data:`SHORT_S`); a filter whose package
     is missing is skipped (its entries absent). ``aligned``: scored instead after fitting
     a constant world and body rotation to each estimate
     (:func:`strapdown.analysis.alignment.aligned_errors`, the metric of the issue's
-    held-back recordings), which forgives a constant offset but not a drift."""
+    held-back recordings), which forgives a constant offset but not a drift. ``alter(rec,
+    k)`` replaces each recording (``k`` its index in the suite) before the filters run: a
+    sensor error the suite does not model, such as an uncalibrated magnetometer."""
     scenarios = suite(seed) if scenarios is None else scenarios
     say = progress or (lambda _m: None)
     ran = [f for f in filters if _available(f) is None]
@@ -68,6 +72,8 @@ def evaluate(scenarios: Sequence[Scenario] | None = None, *, seed: int = 0,
     for k, sc in enumerate(scenarios):
         dur = None if duration_s is None else min(duration_s, sc.duration_s)
         rec = record(sc, np.random.SeedSequence([seed, k]), duration_s=dur)
+        if alter is not None:
+            rec = alter(rec, k)
         tr = trial(rec)
         for f in ran:
             say(f"{sc.name}: {f}")
