@@ -1154,15 +1154,32 @@ def _backward(rec, acc, mag, have_mag: bool, cfg: AhrsConfig, algorithm: str, fw
     # what the forward pass ended with
     out, epoch, _, _ = _filter(rec_b, np.ascontiguousarray(acc[::-1]),
                                np.ascontiguousarray(mag_b),
-                            have_mag, cfg_b, algorithm, fwd.q[-1], -fwd.gyro_bias[-1], ref,
+                            have_mag, cfg_b, algorithm, _backward_start(fwd, rec, cfg),
+                            -fwd.gyro_bias[-1], ref,
                             _Start(True, *gravity, cfg_b.attitude_sigma0), True)
     _to_stamps(out, rec_b.omega, rec, cfg)
+    out.q[0] = fwd.q[-1]  # its start, at the last stamp (_to_stamps keeps a first row)
     rev = np.arange(n)[::-1]
     for f in ("q", "gyro_bias", "accel", "acc_bias", "flags", "nis", "attitude_sigma",
               "attitude_cov", "bias_var"):
         getattr(out, f)[:] = getattr(out, f)[rev]
     out.gyro_bias[:] *= -1.0
     return out, epoch[rev]
+
+
+def _backward_start(fwd, rec, cfg: AhrsConfig) -> np.ndarray:
+    """The backward pass's initial attitude: the forward pass's last, at the last stamp,
+    predicted half a period on (with interval gyro samples): the backward pass's attitudes
+    refer to the middle of each period in its own time, half a period *after* the stamp,
+    and its first step turns its start back a whole period. Without it a spinning record's
+    backward pass started half a period of rotation off (spin-coning, 9.4 rad/s at 400 Hz:
+    0.67°, most of it heading, which the field takes seconds to pull back)."""
+    if cfg.gyro_sample != "interval":
+        return fwd.q[-1]
+    q = np.empty((2, 4))
+    K.predict(np.repeat(fwd.q[-1:], 2, axis=0), np.repeat(rec.omega[-1:], 2, axis=0),
+              np.repeat(fwd.gyro_bias[-1:], 2, axis=0), 0.5 * rec.td, q)
+    return q[1]
 
 
 def _combine(fwd, bwd) -> None:
