@@ -1,7 +1,7 @@
 """The AHRS generalisation suite over several seeds: our filter and VQF on simulated recordings.
 
 Usage: ``python benchmarks/ahrs_generalisation.py [--seeds 0 1 … 19] [--aligned]
-[--hard-iron F --soft-iron F] [--out reports/ahrs_generalisation.json]``.
+[--hard-iron F --soft-iron F] [--acc-sample interval] [--out reports/ahrs_generalisation.json]``.
 
 Each seed draws the sensor errors and the random parts of the motions
 (:func:`strapdown.truth.scenarios.suite`, :func:`~strapdown.truth.scenarios.record`); each
@@ -18,6 +18,8 @@ is one seed of it.
 (:func:`uncalibrated`): the recorded field ``m`` becomes ``S m + F_h |m|_med d``, ``d`` a
 random unit vector in the body, ``S = I + F_s U``, ``U`` uniform in (−1, 1) per entry, drawn
 per seed and recording (docs/reproductions.md, "A magnetometer that is not calibrated").
+``--acc-sample interval`` records every accelerometer sample as the mean specific force over
+its period, like the gyro's (``Sensors.acc_sample``; the suite's are point samples).
 """
 
 from __future__ import annotations
@@ -71,13 +73,17 @@ def main(argv: list[str] | None = None) -> int:
                     help="a hard-iron offset, a fraction of the field's norm (e.g. 0.3)")
     ap.add_argument("--soft-iron", type=float, default=0.0,
                     help="soft-iron scaling: entries of S - I uniform within ± this (e.g. 0.1)")
+    ap.add_argument("--acc-sample", choices=["point", "interval"], default="point",
+                    help="the simulated accelerometer's samples: at the stamps (the suite's) "
+                    "or means over each period, like the gyro's")
     ap.add_argument("--out", default=None, help="write every figure as JSON here")
     args = ap.parse_args(argv)
     per_seed = {}
     names: list[str] = []
     for seed in args.seeds:
         print(f"seed {seed}", file=sys.stderr)
-        scenarios = suite(seed)
+        scenarios = [dataclasses.replace(sc, sensors=dataclasses.replace(
+            sc.sensors, acc_sample=args.acc_sample)) for sc in suite(seed)]
         names = [s.name for s in scenarios]
         alter = None
         if args.hard_iron or args.soft_iron:
