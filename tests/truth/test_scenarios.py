@@ -250,21 +250,25 @@ def test_record_refuses_a_duration_beyond_the_scenario():
         S.record(SUITE["rests"], duration_s=1000.0)
 
 
-def test_interval_accelerometer_mean_is_exact_for_a_ninth_degree_polynomial():
-    """``_interval_mean``: five Gauss–Legendre nodes give the mean over (t_k − h, t_k] of a
-    polynomial of degree 9 to round-off (closed form: the antiderivative's difference)."""
+def test_interval_integrals_are_exact_for_a_polynomial_of_degree_23():
+    """``motions.interval_integrals`` (the gyro's increments and an interval
+    accelerometer's samples): twelve Gauss–Legendre nodes per interval integrate a
+    polynomial of degree 2·12 − 1 to round-off (closed form: the antiderivative's
+    difference)."""
+    from strapdown.truth.motions import QUADRATURE_NODES, interval_integrals
+
     t, h = np.linspace(0.1, 2.0, 7), 0.05
-    c = np.array([0.3, -1.0, 2.0, 0.5, -0.25, 0.1, 0.07, -0.02, 0.01, 0.003])
+    c = np.random.default_rng(3).normal(size=2 * QUADRATURE_NODES)  # degree 23
 
     def f(s):
         return np.stack([np.polyval(c, s), np.polyval(c[-4:], s), np.ones_like(s)], -1)
 
     P = np.polyint(c)
-    want = (np.polyval(P, t) - np.polyval(P, t - h)) / h
-    got = S._interval_mean(f, t, h)
-    assert S.ACC_NODES == 5
-    np.testing.assert_allclose(got[:, 0], want, rtol=1e-13, atol=0)
-    np.testing.assert_allclose(got[:, 2], 1.0, rtol=1e-15, atol=0)
+    want = np.polyval(P, t) - np.polyval(P, t - h)
+    got = interval_integrals(f, t - h, t)
+    assert QUADRATURE_NODES == 12
+    np.testing.assert_allclose(got[:, 0], want, rtol=1e-12, atol=0)
+    np.testing.assert_allclose(got[:, 2], h, rtol=1e-14, atol=0)
 
 
 def test_interval_accelerometer_sample_is_the_mean_specific_force():

@@ -73,7 +73,7 @@ import numpy as np
 from strapdown._core.validation import as_quaternions
 from strapdown.ahrs import _kernel as K
 from strapdown.ahrs.flags import MeasurementFlag
-from strapdown.rotation.quaternion import quat_multiply
+from strapdown.rotation.quaternion import quat_from_rotvec, quat_multiply
 
 __all__ = ["AhrsConfig", "AhrsResult", "attitude_from_acc_mag", "butterworth", "ekf",
            "offline_ekf", "start_is_still", "window_bias_sigma"]
@@ -935,8 +935,6 @@ def _fill_between_epochs(rec, q, bias, last):
     before by one single-period step (``rate-single``, ``td/2 (ω₀ + ω₁) + c td² ω₀ × ω₁``
     with the derived c = 1/6, see :mod:`strapdown.algorithms.rate`) on the gyro corrected
     by the bias of the last epoch. In place."""
-    from strapdown.rotation.quaternion import quat_from_rotvec
-
     n = rec.t.size
     off = np.arange(n) - last  # samples since the last epoch (0 at epochs and row 0)
     h = rec.td
@@ -1176,10 +1174,8 @@ def _backward_start(fwd, rec, cfg: AhrsConfig) -> np.ndarray:
     0.67°, most of it heading, which the field takes seconds to pull back)."""
     if cfg.gyro_sample != "interval":
         return fwd.q[-1]
-    q = np.empty((2, 4))
-    K.predict(np.repeat(fwd.q[-1:], 2, axis=0), np.repeat(rec.omega[-1:], 2, axis=0),
-              np.repeat(fwd.gyro_bias[-1:], 2, axis=0), 0.5 * rec.td, q)
-    return q[1]
+    return quat_multiply(fwd.q[-1], quat_from_rotvec(0.5 * rec.td
+                                                     * (rec.omega[-1] - fwd.gyro_bias[-1])))
 
 
 def _combine(fwd, bwd) -> None:
@@ -1187,7 +1183,7 @@ def _combine(fwd, bwd) -> None:
     attitude ``q_f ⊗ exp(G δ)`` with ``δ = log(q_f* ⊗ q_b)`` (body frame) and
     ``G = P_f (P_f + P_b)⁻¹``, its covariance ``P_f − G P_f``; the gyro bias weighted
     by the inverse variances."""
-    from strapdown.rotation.quaternion import quat_conjugate, quat_from_rotvec, rotvec_from_quat
+    from strapdown.rotation.quaternion import quat_conjugate, rotvec_from_quat
 
     dq = quat_multiply(quat_conjugate(fwd.q), bwd.q)
     delta = rotvec_from_quat(dq * np.where(dq[:, :1] < 0, -1.0, 1.0))

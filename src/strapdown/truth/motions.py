@@ -40,6 +40,7 @@ __all__ = [
     "RotationSequenceMotion",
     "SpinConing",
     "UserMotion",
+    "interval_integrals",
 ]
 
 #: Gauss–Legendre nodes per interval for motions without closed-form increments.
@@ -49,6 +50,18 @@ _GL_X, _GL_W = np.polynomial.legendre.leggauss(QUADRATURE_NODES)
 
 #: A user function of time: float64 times in, values of shape ``t.shape + (k,)`` out.
 TimeFunction = Callable[[NDArray[np.float64]], ArrayLike]
+
+
+def interval_integrals(f: TimeFunction, t0: NDArray[np.float64],
+                       t1: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``∫ f dt`` over each interval ``[t0_i, t1_i]``, shape ``(n, k)``: Gauss–Legendre
+    quadrature with :data:`QUADRATURE_NODES` nodes per interval (exact for a polynomial of
+    degree ``2 QUADRATURE_NODES − 1``); ``f`` is evaluated at all nodes in one call."""
+    mid = 0.5 * (t0 + t1)
+    half = 0.5 * (t1 - t0)
+    nodes = mid[:, None] + half[:, None] * _GL_X[None, :]
+    vals = np.asarray(f(nodes))  # (n, nodes, k)
+    return half[:, None] * np.einsum("k,nkj->nj", _GL_W, vals)
 
 
 class Motion(abc.ABC):
@@ -80,11 +93,7 @@ class Motion(abc.ABC):
         return self._increments(e[:-1], e[1:])
 
     def _increments(self, t0: NDArray[np.float64], t1: NDArray[np.float64]) -> NDArray[np.float64]:
-        mid = 0.5 * (t0 + t1)
-        half = 0.5 * (t1 - t0)
-        nodes = mid[:, None] + half[:, None] * _GL_X[None, :]
-        w = self.rate(nodes)  # (n, nodes, 3)
-        return half[:, None] * np.einsum("k,nkj->nj", _GL_W, w)
+        return interval_integrals(self.rate, t0, t1)
 
     # --- arbitrary precision (closed-form motions only) -----------------------------
     @property

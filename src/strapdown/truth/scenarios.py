@@ -58,7 +58,13 @@ from strapdown.rotation.quaternion import (
     quat_multiply,
     quat_rotate,
 )
-from strapdown.truth.motions import Motion, RotationSequenceMotion, SpinConing, UserMotion
+from strapdown.truth.motions import (
+    Motion,
+    RotationSequenceMotion,
+    SpinConing,
+    UserMotion,
+    interval_integrals,
+)
 from strapdown.truth.recordings import EARTH_FIELD_UT, G, hand_held
 from strapdown.truth.sensors import (
     AccelerometerErrors,
@@ -226,8 +232,8 @@ class Sensors:
         What an accelerometer sample is: the specific force at the stamp (``point``,
         default: the suite's recordings) or its mean over the sample period that ends at
         the stamp (``interval``: gyro and accelerometer through one decimation filter, as
-        the gyro samples here always are), by :data:`ACC_NODES`-point Gauss–Legendre
-        quadrature of the exact specific force.
+        the gyro samples here always are), by Gauss–Legendre quadrature of the exact
+        specific force (:func:`~strapdown.truth.motions.interval_integrals`).
     """
 
     rate_hz: float
@@ -322,21 +328,6 @@ class SimulatedRecording:
         return self.scenario.name
 
 
-#: Gauss–Legendre nodes per sample period of an interval accelerometer sample (exact for
-#: a specific force polynomial of degree 9 over the period; a 2 s quintic turn at 50 Hz or a
-#: 1.5 Hz spin at 400 Hz is smooth to far below the sensors' noise over one period).
-ACC_NODES = 5
-
-
-def _interval_mean(f: Callable[[NDArray[np.float64]], NDArray[np.float64]],
-                   t: NDArray[np.float64], h: float) -> NDArray[np.float64]:
-    """The mean of ``f`` (a function of time, (…, 3)) over each period ``(t_k − h, t_k]``."""
-    x, wts = np.polynomial.legendre.leggauss(ACC_NODES)
-    nodes = t[:, None] - 0.5 * h * (1.0 - x[None, :])  # (n, nodes) within each period
-    vals = np.asarray(f(nodes.ravel()), float).reshape(t.size, ACC_NODES, 3)
-    return 0.5 * np.einsum("j,njc->nc", wts, vals)
-
-
 def record(scenario: Scenario, seed: RngLike = 0, *, noise: bool = True,
            duration_s: float | None = None) -> SimulatedRecording:
     """Sample ``scenario`` at its rate from ``t = 0`` for ``duration_s`` (default: the
@@ -352,8 +343,8 @@ def record(scenario: Scenario, seed: RngLike = 0, *, noise: bool = True,
     edges = np.concatenate([[t[0] - h], t])
     w = body.motion.increments(edges) / h
     q = body.attitude(t)
-    f = body.specific_force(t) if s.acc_sample == "point" else _interval_mean(
-        body.specific_force, t, h)
+    f = (body.specific_force(t) if s.acc_sample == "point"  # else the mean over each period
+         else interval_integrals(body.specific_force, edges[:-1], t) / np.diff(edges)[:, None])
     m_b = body.field_b(t)
     bias = np.zeros((n, 3))
     if noise:
