@@ -234,11 +234,18 @@ class Params(NamedTuple):
 
 
 class Initial(NamedTuple):
-    """Initial q_n_b (4,), gyro bias (3,) and error covariance (6, 9 or 12 square)."""
+    """Initial q_n_b (4,), gyro bias (3,) and error covariance (6, 9 or 12 square); the
+    low-pass model's initial state (4,), NaN for none (the low-pass then averages its
+    first ``lp_init_n`` epochs): the low-passed specific force in the reference frame and
+    the motion power through it (:func:`_motion_power`), as :func:`ekf_kernel` returns
+    them; and the epochs before the low-pass model's first update unless the
+    accelerometer is quiet (0: none)."""
 
     q: np.ndarray
     gyro_bias: np.ndarray
     P: np.ndarray
+    lowpass: np.ndarray
+    lowpass_wait: int
 
 
 class Outputs(NamedTuple):
@@ -1317,7 +1324,10 @@ def _reset(slot, q, ring, bias, accel, acc_bias, P, C, dx, eps, singer):
 # module docstring).
 @njit(cache=True, error_model="numpy")
 def ekf_kernel(sensors, prop, window, params, init, out):
-    """Run the filter over the record; returns the number of output rows written.
+    """Run the filter over the record; returns the number of epochs run, gravity's norm as
+    measured and whether a rest measured it, the online hard-iron offset (3 values) and
+    the low-pass model's state at the end (4 values, :attr:`Initial.lowpass`; NaN when the
+    model never ran).
 
     Records: :class:`Sensors`, :class:`Propagation`, :class:`Window`,
     :class:`Params`, :class:`Initial`, :class:`Outputs`; the stages are listed in the
@@ -1375,6 +1385,13 @@ def ekf_kernel(sensors, prop, window, params, init, out):
     lp_s0 = np.zeros(3)
     lp_s1 = np.zeros(3)
     lp_n = 0
+    if params.acc_lowpass and np.all(np.isfinite(init.lowpass[:3])):
+        # started in the steady state of a constant input (as _lowpass after its average)
+        lp_n = params.lp_init_n
+        for a in range(3):
+            lp[a] = init.lowpass[a]
+            lp_s0[a] = lp[a] * (1.0 - params.lp_b0)
+            lp_s1[a] = lp[a] * (params.lp_b2 - params.lp_a2)
     mn = np.empty(3)
     v = np.empty(3)
     eps = np.empty(3)
@@ -1433,8 +1450,12 @@ def ekf_kernel(sensors, prop, window, params, init, out):
     m_raw = np.empty(3)
     ref_heading = params.ref_heading
     refer = 0
-    dyn2 = 0.0  # moving mean square of the motion acceleration through the low-pass
+    # moving mean square of the motion acceleration through the low-pass
+    dyn2 = init.lowpass[3] if lp_n > 0 else 0.0
     lp2 = np.zeros(3)  # slow mean of the low-passed specific force
+    if lp_n > 0:  # an initial low-pass (Initial.lowpass) is its slow mean's start too
+        for a in range(3):
+            lp2[a] = lp[a]
     rest_since = -1.0  # start of the current run of rest detections (−1: none)
     acc_bad_since = -1.0  # start of the current run of rejections (−1: none)
     mag_bad_since = -1.0
@@ -1510,7 +1531,8 @@ def ekf_kernel(sensors, prop, window, params, init, out):
                 # lp_settle = 0: no update while the low-pass is still averaging its first
                 # lp_init_n epochs unless the accelerometer is quiet (a running mean of a
                 # few samples in motion is not gravity)
-                if not disturbed and (acc_quiet or lp_n >= params.lp_init_n + params.lp_settle):
+                if not disturbed and (acc_quiet or (lp_n >= params.lp_init_n + params.lp_settle
+                                                       and e >= init.lowpass_wait)):
                     nis_acc, ok = _gated_update(P, H_lp, 3 if nx == 6 else nx,
                                                 _lowpass_variance(params, dyn2, T), y2,
                                                 params.acc_gate_lowpass, params.gating, force,
@@ -1639,7 +1661,11 @@ def ekf_kernel(sensors, prop, window, params, init, out):
         out_flags[k] = flags
         out_nis[k, 0] = nis_acc
         out_nis[k, 1] = nis_mag
-    return total, g_meas, g_known, hv[V_APP, 0], hv[V_APP, 1], hv[V_APP, 2]
+    if lp_n == 0:  # the low-pass model never ran: no state to hand on
+        for a in range(3):
+            lp[a] = np.nan
+    return (total, g_meas, g_known, hv[V_APP, 0], hv[V_APP, 1], hv[V_APP, 2], lp[0], lp[1],
+            lp[2], dyn2)
 
 
 @njit(cache=True, error_model="numpy")
