@@ -55,8 +55,9 @@ def test_rotvec_from_quat_ignores_the_sign(case):
     generic = q[..., 0] != 0.0
     assert np.array_equal(a[generic], b[generic])
     assert _half_turns_agree(a[~generic], b[~generic])
-    # principal: |φ| ≤ π up to the rounding of scale·v (nextafter(π) seen at w = 0)
-    assert np.all(np.linalg.norm(a, axis=-1) <= np.nextafter(np.pi, 4.0))
+    # principal: |φ| ≤ π up to the roundings of scale·v and of its norm taken again
+    # (nextafter(π) seen at w = 0; a run found more at w = 6e-17, as in the test above)
+    assert np.all(np.linalg.norm(a, axis=-1) <= np.pi * (1.0 + 4.0 * np.finfo(float).eps))
 
 
 @given(_pairs())
