@@ -943,7 +943,7 @@ def _run(rec, acc, mag, prop: K.Propagation, window: K.Window, params: K.Params,
     out.bias_var[0] = np.diag(init.P)[3:6]
     out.mag_delay[0] = params.mag_delay
     k, g, g_known, *rest = K.ekf_kernel(K.Sensors(np.ascontiguousarray(x), acc, mag,
-                                                    float(h)), prop, window, params, init, out)
+                                                  float(h)), prop, window, params, init, out)
     return out, k, (float(g), bool(g_known)), np.array(rest[:3]), np.array(rest[3:])
 
 
@@ -1139,8 +1139,8 @@ def ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
     cfg = config or AhrsConfig()
     rec, acc, mag, have_mag, q_init, b0, ref, start = _setup(t, gyro, acc, mag, cfg, q0,
                                                               gyro_bias0, mag_reference, frame)
-    out, epoch, _, offset, _ = _filter(rec, acc, mag, have_mag, cfg, algorithm, q_init, b0, ref,
-                                    start)
+    out, epoch, _, offset, _ = _filter(rec, acc, mag, have_mag, cfg, algorithm, q_init, b0,
+                                       ref, start)
     return replace(_result(rec, out, epoch, frame, have_mag, algorithm, cfg, start),
                    mag_offset=offset if np.any(offset) else None)
 
@@ -1176,11 +1176,10 @@ def _backward(rec, acc, mag, have_mag: bool, cfg: AhrsConfig, algorithm: str, fw
     # its start is the forward pass's end: still or not, no window is averaged; gravity is
     # what the forward pass ended with
     out, epoch, *_ = _filter(rec_b, np.ascontiguousarray(acc[::-1]),
-                               np.ascontiguousarray(mag_b),
-                            have_mag, cfg_b, algorithm, _backward_start(fwd, rec, cfg),
-                            -fwd.gyro_bias[-1], ref,
-                            _Start(True, *gravity, cfg_b.attitude_sigma0), True, lowpass,
-                            cfg.offline_lowpass_wait * cfg.acc_lowpass_s)
+                             np.ascontiguousarray(mag_b), have_mag, cfg_b, algorithm,
+                             _backward_start(fwd, rec, cfg), -fwd.gyro_bias[-1], ref,
+                             _Start(True, *gravity, cfg_b.attitude_sigma0), True, lowpass,
+                             cfg.offline_lowpass_wait * cfg.acc_lowpass_s)
     _to_stamps(out, rec_b.omega, rec, cfg)
     out.q[0] = fwd.q[-1]  # its start, at the last stamp (_to_stamps keeps a first row)
     rev = np.arange(n)[::-1]
