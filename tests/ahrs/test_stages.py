@@ -627,6 +627,100 @@ def test_consider_update_gate(k):
     assert ok
 
 
+def _level(k, P, H, kc, r, y, gate=1e9, soft=False, force=False):
+    n = P.shape[0]
+    dx = np.zeros(n)
+    out = k._level_update(P, H, kc, r, y, gate, True, force, soft, dx, C_HAT, np.empty(n),
+                          np.empty(n), np.empty(n), np.empty((2, 2)), np.empty((2, 2)))
+    return out, dx
+
+
+def _level_expected(P, H, r, y):
+    """Row after row in matrix form: K = P hᵀ/s with its attitude part projected off the
+    body-frame vertical c, P by the Joseph form (I − K h) P (I − K h)ᵀ + K r Kᵀ, the row's
+    innovation less h times the earlier rows' correction."""
+    P = P.copy()
+    c = C_HAT[2]
+    dx = np.zeros(P.shape[0])
+    for h, yj in zip(H, y, strict=True):
+        s = h @ P @ h + r
+        kk = P @ h / s
+        kk[:3] -= c * (c @ kk[:3])
+        A = np.eye(P.shape[0]) - np.outer(kk, h)
+        P = A @ P @ A.T + r * np.outer(kk, kk)
+        dx += kk * (yj - h @ dx)
+    return P, dx
+
+
+@pytest.mark.parametrize("nx", [6, 9, 12])
+def test_level_update_gain_stays_off_the_heading(k, nx):
+    """The accelerometer's update without a magnetometer (6-axis): each row's gain has its
+    attitude part projected off the reference vertical, P by the Joseph form for it; the
+    correction turns the estimate about horizontal axes only, while the full Kalman update
+    (:func:`_gated_update`) on the same correlated P turns the heading too."""
+    rng = np.random.default_rng(nx)
+    P = _spd(rng, nx)
+    H = np.zeros((2, nx))
+    H[0, :3] = -G * C_HAT[1]  # the low-pass model's rows (_acc_lowpass_model)
+    H[1, :3] = G * C_HAT[0]
+    kc = 3 if nx == 6 else nx
+    r, y = 4e-4, np.array([0.03, -0.02])
+    P0 = P.copy()
+    S = H @ P0 @ H.T + r * np.eye(2)
+    P_exp, dx_exp = _level_expected(P0, H, r, y)
+    (nis, ok), dx = _level(k, P, H, kc, r, y)
+    assert ok and nis == pytest.approx(y @ np.linalg.solve(S, y), rel=1e-12)
+    assert np.allclose(dx, dx_exp, rtol=1e-11, atol=1e-18)
+    assert np.allclose(P, P_exp, rtol=1e-10, atol=1e-16)
+    up = (C_HAT @ dx[:3])[2]  # the correction in the reference frame: none about up
+    assert abs(up) < 1e-15 * np.linalg.norm(dx[:3])
+    full = np.zeros(nx)
+    k._gated_update(P0.copy(), H, kc, r, y, 1e9, True, False, False, full,
+                    np.empty((nx, 2)), np.empty((2, 2)), np.empty((2, 2)))
+    assert abs((C_HAT @ full[:3])[2]) > 1e-3 * np.linalg.norm(full[:3])
+
+
+def test_level_update_is_the_kalman_update_when_the_projection_is_neutral(k):
+    """An attitude covariance with no heading part (isotropic in the horizontal, nothing
+    about c) and no correlation with it: the projected gain is the Kalman gain, and the
+    result equals :func:`_gated_update`'s."""
+    c = C_HAT[2]
+    horiz = np.eye(3) - np.outer(c, c)
+    P = np.zeros((6, 6))
+    P[:3, :3] = 1e-3 * horiz
+    P[3:, 3:] = 1e-5 * np.eye(3)
+    H = np.zeros((2, 6))
+    H[0, :3] = -G * C_HAT[1]
+    H[1, :3] = G * C_HAT[0]
+    y = np.array([0.03, -0.02])
+    (_, ok), dx = _level(k, P.copy(), H, 3, 4e-4, y)
+    full = np.zeros(6)
+    Pf = P.copy()
+    k._gated_update(Pf, H, 3, 4e-4, y, 1e9, True, False, False, full, np.empty((6, 2)),
+                    np.empty((2, 2)), np.empty((2, 2)))
+    assert ok and np.allclose(dx, full, rtol=1e-12, atol=1e-18)
+
+
+def test_level_update_gate(k):
+    """NIS beyond a hard gate: rejected, P and dx untouched; a soft gate scales r by
+    NIS/gate; forced: accepted."""
+    P = np.diag([1e-4] * 3 + [1e-6] * 3)
+    H = np.zeros((2, 6))
+    H[0, :3] = -G * C_HAT[1]
+    H[1, :3] = G * C_HAT[0]
+    y = np.array([0.05, 0.02])
+    S = H @ P @ H.T + 1e-4 * np.eye(2)
+    nis_expect = y @ np.linalg.solve(S, y)
+    (nis, ok), dx = _level(k, P, H, 3, 1e-4, y, gate=0.99 * nis_expect)
+    assert not ok and nis == pytest.approx(nis_expect, rel=1e-12)
+    assert np.array_equal(P, np.diag([1e-4] * 3 + [1e-6] * 3)) and not dx.any()
+    (_, ok), dx = _level(k, P.copy(), H, 3, 1e-4, y, gate=0.5 * nis_expect, soft=True)
+    _, dx_exp = _level_expected(P, H, 1e-4 * 2.0, y)
+    assert ok and np.allclose(dx, dx_exp, rtol=1e-11, atol=1e-18)
+    (_, ok), _ = _level(k, P.copy(), H, 3, 1e-4, y, gate=0.5 * nis_expect, force=True)
+    assert ok
+
+
 def _ms(p, norm=REF[0], dip=REF[1], undisturbed=None):
     """The disturbance state as the kernel starts it."""
     ms = np.zeros(8)

@@ -19,6 +19,8 @@ a small function that numba inlines into the loop (``inline="always"``):
    VQF's idea: the specific force in the almost-inertial reference frame through a
    second-order Butterworth low-pass, :func:`_lowpass`) or :func:`_acc_plausible`,
    :func:`_lever_sigma` and :func:`_acc_raw_model` (the Singer (1970) manoeuvre state);
+   the low-pass model's update is :func:`_gated_update`, or without a magnetometer
+   :func:`_level_update`, whose gain never reaches the heading;
 6. the magnetometer as a heading measurement: the field rotated into the reference
    frame with the attitude of the magnetometer's delay earlier (:func:`_delayed_field`;
    the delay fixed or estimated online, :func:`_fold_delay_samples` and
@@ -470,6 +472,63 @@ def _gated_update(P, H, kc, r, y, gate, gating, force, soft, dx, U, S, Sinv):
             ui = U[i, j] * ij
             for k in range(n):
                 P[i, k] -= ui * U[k, j]
+    return nis, True
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _level_update(P, H, kc, r, y, gate, gating, force, soft, dx, C, u, K, w, S, Sinv):
+    """:func:`_gated_update` with the gain kept off the heading; returns (NIS, accepted).
+
+    The NIS and the gate are :func:`_gated_update`'s (``S = H P Hᵀ + R``, H zero beyond
+    its first ``kc`` columns). Then each row in turn: ``u = P hⱼᵀ``, ``s = hⱼ·u + r``,
+    ``K = u / s`` with its attitude part projected off the reference vertical (``c = C₃ᵀ``
+    in the body frame: ``K_θ ← (I − c cᵀ) K_θ``), the other states' as they are, and P the
+    Joseph form for that gain, ``P − K uᵀ − u Kᵀ + s K Kᵀ``, exact for any gain; the row's
+    innovation less what the earlier rows' corrections explain. dx += Σ K innov. Work
+    arrays u, K, w (n,), S, Sinv (m × m). The counterpart of :func:`_consider_update`,
+    whose gain stays off roll and pitch.
+    """
+    m = y.size
+    n = P.shape[0]
+    nis = 0.0
+    if gating and not force:
+        for i in range(m):
+            for j in range(m):
+                acc = r if i == j else 0.0
+                for k in range(kc):
+                    for q in range(kc):
+                        acc += H[i, k] * P[k, q] * H[j, q]
+                S[i, j] = acc
+        _inverse_sym(S, m, Sinv)
+        for i in range(m):
+            for j in range(m):
+                nis += y[i] * Sinv[i, j] * y[j]
+        if nis > gate:
+            if not soft:
+                return nis, False
+            r *= nis / gate
+    for i in range(n):
+        w[i] = 0.0
+    for j in range(m):
+        sj = r
+        innov = y[j]
+        for i in range(n):
+            acc = 0.0
+            for k in range(kc):
+                acc += P[i, k] * H[j, k]
+            u[i] = acc
+        for k in range(kc):
+            sj += H[j, k] * u[k]
+            innov -= H[j, k] * w[k]
+        kv = (C[2, 0] * u[0] + C[2, 1] * u[1] + C[2, 2] * u[2]) / sj
+        for i in range(n):
+            K[i] = u[i] / sj - (C[2, i] * kv if i < 3 else 0.0)
+        for i in range(n):
+            for k in range(n):
+                P[i, k] += sj * K[i] * K[k] - K[i] * u[k] - u[i] * K[k]
+            w[i] += K[i] * innov
+    for i in range(n):
+        dx[i] += w[i]
     return nis, True
 
 
@@ -1411,6 +1470,7 @@ def ekf_kernel(sensors, prop, window, params, init, out):
     y1 = np.empty(1)
     ku = np.empty(nx)
     kk = np.empty(nx)
+    lw = np.empty(nx)
     U3 = np.empty((nx, 3))
     U2 = np.empty((nx, 2))
     S3 = np.empty((3, 3))
@@ -1538,7 +1598,16 @@ def ekf_kernel(sensors, prop, window, params, init, out):
                 # few samples in motion is not gravity)
                 if not disturbed and (acc_quiet or (lp_n >= params.lp_init_n + params.lp_settle
                                                        and e >= init.lowpass_wait)):
-                    nis_acc, ok = _gated_update(P, H_lp, 3 if nx == 6 else nx,
+                    # without a field the heading is the gyro's alone: the accelerometer's
+                    # gain is kept off it (_level_update)
+                    if not params.use_magnetometer:
+                        nis_acc, ok = _level_update(P, H_lp, 3 if nx == 6 else nx,
+                                                    _lowpass_variance(params, dyn2, T), y2,
+                                                    params.acc_gate_lowpass, params.gating,
+                                                    force, params.soft_gate, dx, C, ku, kk,
+                                                    lw, S2, Si2)
+                    else:
+                        nis_acc, ok = _gated_update(P, H_lp, 3 if nx == 6 else nx,
                                                 _lowpass_variance(params, dyn2, T), y2,
                                                 params.acc_gate_lowpass, params.gating, force,
                                                 params.soft_gate, dx, U2, S2, Si2)

@@ -20,7 +20,8 @@ with the accelerometer and magnetometer handling of Laidig & Seel (2023)):
   the accelerometer — by default the specific force rotated into the reference
   frame through a second-order Butterworth low-pass, whose states follow every
   correction (an almost-inertial frame, Laidig & Seel's), taken as gravity on its
-  horizontal axes; or the paper's ``f = C_b_n g_up + a_b`` for every sample — and
+  horizontal axes (without a magnetometer its gain stays off the heading, which then is
+  the gyro's alone); or the paper's ``f = C_b_n g_up + a_b`` for every sample — and
   the magnetometer as a heading measurement: the field, rotated with the attitude
   of the magnetometer's delay earlier (estimated online), gives the heading of its
   horizontal part; the innovation variance carries the tilt uncertainty through
