@@ -630,8 +630,9 @@ def test_consider_update_gate(k):
 def _level(k, P, H, kc, r, y, gate=1e9, soft=False, force=False):
     n = P.shape[0]
     dx = np.zeros(n)
-    out = k._level_update(P, H, kc, r, y, gate, True, force, soft, dx, C_HAT, np.empty(n),
-                          np.empty(n), np.empty(n), np.empty((2, 2)), np.empty((2, 2)))
+    out = k._level_update(P, H, kc, r, y, gate, True, force, soft, dx, C_HAT,
+                          np.empty((n, 2)), np.empty(n), np.empty(n), np.empty((2, 2)),
+                          np.empty((2, 2)))
     return out, dx
 
 

@@ -411,23 +411,13 @@ def _inverse_sym(S, m, out):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _gated_update(P, H, kc, r, y, gate, gating, force, soft, dx, U, S, Sinv):
-    """Gated update of P with m ≤ 3 rows H, noise ``R = r I`` and innovation y; returns
-    (NIS, accepted). dx += K y. H is zero beyond its first ``kc`` columns.
-
-    The NIS ``yᵀ S⁻¹ y`` (``S = H U + R``, ``U = P Hᵀ``) decides first: beyond the gate
-    a hard gate rejects, a soft gate de-weights (R scaled by NIS/gate, a Huber-type
-    bounded step). Then, R being diagonal, the rows are applied one after the other,
-    which equals the joint update exactly: row j's ``u_j = P_j hⱼᵀ`` on the P the
-    earlier rows left is ``U_j − Σ_{i<j} u_i (hⱼ·u_i)/s_i`` (U's columns become the
-    u_j), ``s_j = hⱼ·u_j + r``, its gain step ``g_j = (y_j − Σ_{i<j} (hⱼ·u_i) g_i)/s_j``;
-    then ``dx += Σ u_j g_j`` and ``P ← P − Σ u_j u_jᵀ/s_j`` (symmetric). Work arrays
-    U (n × m); S and Sinv (m × m) hold the gain steps and 1/s_j in their first column
-    once the NIS is taken.
-    """
+def _gate(P, H, kc, r, y, gate, gating, force, soft, U, S, Sinv):
+    """The gate of :func:`_gated_update` and :func:`_level_update`: fills ``U = P Hᵀ``
+    (n × m) and, when gating (and not forced), ``S = H U + r I``, its inverse and the NIS
+    ``yᵀ S⁻¹ y``; returns (NIS, r, accepted) — beyond ``gate`` a hard gate rejects, a soft
+    one returns r scaled by NIS/gate."""
     m = y.size
-    n = P.shape[0]
-    for i in range(n):
+    for i in range(P.shape[0]):
         for j in range(m):
             acc = 0.0
             for k in range(kc):
@@ -447,8 +437,31 @@ def _gated_update(P, H, kc, r, y, gate, gating, force, soft, dx, U, S, Sinv):
                 nis += y[i] * Sinv[i, j] * y[j]
         if nis > gate:
             if not soft:
-                return nis, False
+                return nis, r, False
             r *= nis / gate
+    return nis, r, True
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _gated_update(P, H, kc, r, y, gate, gating, force, soft, dx, U, S, Sinv):
+    """Gated update of P with m ≤ 3 rows H, noise ``R = r I`` and innovation y; returns
+    (NIS, accepted). dx += K y. H is zero beyond its first ``kc`` columns.
+
+    The NIS ``yᵀ S⁻¹ y`` (``S = H U + R``, ``U = P Hᵀ``) decides first: beyond the gate
+    a hard gate rejects, a soft gate de-weights (R scaled by NIS/gate, a Huber-type
+    bounded step). Then, R being diagonal, the rows are applied one after the other,
+    which equals the joint update exactly: row j's ``u_j = P_j hⱼᵀ`` on the P the
+    earlier rows left is ``U_j − Σ_{i<j} u_i (hⱼ·u_i)/s_i`` (U's columns become the
+    u_j), ``s_j = hⱼ·u_j + r``, its gain step ``g_j = (y_j − Σ_{i<j} (hⱼ·u_i) g_i)/s_j``;
+    then ``dx += Σ u_j g_j`` and ``P ← P − Σ u_j u_jᵀ/s_j`` (symmetric). Work arrays
+    U (n × m); S and Sinv (m × m) hold the gain steps and 1/s_j in their first column
+    once the NIS is taken.
+    """
+    m = y.size
+    n = P.shape[0]
+    nis, r, ok = _gate(P, H, kc, r, y, gate, gating, force, soft, U, S, Sinv)
+    if not ok:
+        return nis, False
     for j in range(m):
         innov = y[j]
         for i in range(j):
@@ -476,56 +489,42 @@ def _gated_update(P, H, kc, r, y, gate, gating, force, soft, dx, U, S, Sinv):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _level_update(P, H, kc, r, y, gate, gating, force, soft, dx, C, u, K, w, S, Sinv):
+def _level_update(P, H, kc, r, y, gate, gating, force, soft, dx, C, U, K, w, S, Sinv):
     """:func:`_gated_update` with the gain kept off the heading; returns (NIS, accepted).
 
-    The NIS and the gate are :func:`_gated_update`'s (``S = H P Hᵀ + R``, H zero beyond
-    its first ``kc`` columns). Then each row in turn: ``u = P hⱼᵀ``, ``s = hⱼ·u + r``,
+    The NIS and the gate are :func:`_gated_update`'s (:func:`_gate`; H zero beyond its
+    first ``kc`` columns). Then each row in turn: ``u = P hⱼᵀ``, ``s = hⱼ·u + r``,
     ``K = u / s`` with its attitude part projected off the reference vertical (``c = C₃ᵀ``
     in the body frame: ``K_θ ← (I − c cᵀ) K_θ``), the other states' as they are, and P the
     Joseph form for that gain, ``P − K uᵀ − u Kᵀ + s K Kᵀ``, exact for any gain; the row's
     innovation less what the earlier rows' corrections explain. dx += Σ K innov. Work
-    arrays u, K, w (n,), S, Sinv (m × m). The counterpart of :func:`_consider_update`,
-    whose gain stays off roll and pitch.
+    arrays U (n × m; column j holds row j's u), K, w (n,), S, Sinv (m × m). The
+    counterpart of :func:`_consider_update`, whose gain stays off roll and pitch.
     """
     m = y.size
     n = P.shape[0]
-    nis = 0.0
-    if gating and not force:
-        for i in range(m):
-            for j in range(m):
-                acc = r if i == j else 0.0
-                for k in range(kc):
-                    for q in range(kc):
-                        acc += H[i, k] * P[k, q] * H[j, q]
-                S[i, j] = acc
-        _inverse_sym(S, m, Sinv)
-        for i in range(m):
-            for j in range(m):
-                nis += y[i] * Sinv[i, j] * y[j]
-        if nis > gate:
-            if not soft:
-                return nis, False
-            r *= nis / gate
+    nis, r, ok = _gate(P, H, kc, r, y, gate, gating, force, soft, U, S, Sinv)
+    if not ok:
+        return nis, False
     for i in range(n):
         w[i] = 0.0
     for j in range(m):
         sj = r
         innov = y[j]
-        for i in range(n):
+        for i in range(n if j > 0 else 0):  # row 0's u is the gate's; later rows' P moved
             acc = 0.0
             for k in range(kc):
                 acc += P[i, k] * H[j, k]
-            u[i] = acc
+            U[i, j] = acc
         for k in range(kc):
-            sj += H[j, k] * u[k]
+            sj += H[j, k] * U[k, j]
             innov -= H[j, k] * w[k]
-        kv = (C[2, 0] * u[0] + C[2, 1] * u[1] + C[2, 2] * u[2]) / sj
+        kv = (C[2, 0] * U[0, j] + C[2, 1] * U[1, j] + C[2, 2] * U[2, j]) / sj
         for i in range(n):
-            K[i] = u[i] / sj - (C[2, i] * kv if i < 3 else 0.0)
+            K[i] = U[i, j] / sj - (C[2, i] * kv if i < 3 else 0.0)
         for i in range(n):
             for k in range(n):
-                P[i, k] += sj * K[i] * K[k] - K[i] * u[k] - u[i] * K[k]
+                P[i, k] += sj * K[i] * K[k] - K[i] * U[k, j] - U[i, j] * K[k]
             w[i] += K[i] * innov
     for i in range(n):
         dx[i] += w[i]
@@ -1470,7 +1469,6 @@ def ekf_kernel(sensors, prop, window, params, init, out):
     y1 = np.empty(1)
     ku = np.empty(nx)
     kk = np.empty(nx)
-    lw = np.empty(nx)
     U3 = np.empty((nx, 3))
     U2 = np.empty((nx, 2))
     S3 = np.empty((3, 3))
@@ -1604,8 +1602,8 @@ def ekf_kernel(sensors, prop, window, params, init, out):
                         nis_acc, ok = _level_update(P, H_lp, 3 if nx == 6 else nx,
                                                     _lowpass_variance(params, dyn2, T), y2,
                                                     params.acc_gate_lowpass, params.gating,
-                                                    force, params.soft_gate, dx, C, ku, kk,
-                                                    lw, S2, Si2)
+                                                    force, params.soft_gate, dx, C, U2, ku,
+                                                    kk, S2, Si2)
                     else:
                         nis_acc, ok = _gated_update(P, H_lp, 3 if nx == 6 else nx,
                                                 _lowpass_variance(params, dyn2, T), y2,
