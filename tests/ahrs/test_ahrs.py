@@ -640,3 +640,41 @@ def test_six_axis_accelerometer_leaves_the_heading_to_the_gyro():
     e = broad_errors(ekf(tr.t, tr.gyro, tr.acc, None).q, rec.q_n_b, tr.movement,
                      remove_heading_offset=True)
     assert e["total_offset_removed_deg"] < 0.12, e
+
+
+@pytest.mark.parametrize("run_name", ["ekf", "offline_ekf"])
+def test_an_unused_accelerometer_is_said(run_name):
+    """A record that starts in motion and never rests leaves gravity's norm unmeasured; an
+    accelerometer whose norm is 3.5 % low (a scale error, as on three OpenAXES recordings)
+    or high then fails the low-pass norm test at every epoch, and the filter says so
+    (:class:`AccelerometerUnusedWarning`) instead of returning a gyro-only tilt silently —
+    naming a scale error for a short norm, a sustained acceleration too for a long one.
+    The same record read at its true scale, or with that scale's gravity given, is used
+    and says nothing."""
+    import warnings
+
+    from strapdown.ahrs import AccelerometerUnusedWarning, offline_ekf, start_is_still
+
+    run = {"ekf": ekf, "offline_ekf": offline_ekf}[run_name]
+    h = 0.01
+    t = np.arange(2000) * h
+    w = np.tile([0.0, 0.0, 0.5], (t.size, 1))  # a spin about the vertical: never a rest
+    g = AhrsConfig().gravity
+    assert not start_is_still(t, w, np.tile([0.0, 0.0, g], (t.size, 1)))
+    for scale, cfg, warned in ((0.965, AhrsConfig(), "-3.5 %"), (1.035, AhrsConfig(), "+3.5 %"),
+                               (1.0, AhrsConfig(), ""),
+                               (0.965, AhrsConfig(gravity=0.965 * g), "")):
+        acc = np.tile([0.0, 0.0, scale * g], (t.size, 1))
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            r = run(t, w, acc, config=cfg)
+        said = [c for c in caught if issubclass(c.category, AccelerometerUnusedWarning)]
+        assert len(said) == int(bool(warned)), (scale, cfg.gravity)
+        if warned:
+            text = str(said[0].message)
+            assert warned in text and "AhrsConfig(gravity=" in text
+            # a short norm can only be the scale; a long one may be a sustained turn
+            assert ("sustained acceleration" in text) == (scale > 1.0)
+            assert r.fraction(Flag.ACC_DISTURBED) > 0.9
+        else:
+            assert r.fraction(Flag.ACC_USED) > 0.9

@@ -1,7 +1,8 @@
 """``strapdown benchmark-ahrs --suite openaxes``: the table's arithmetic on given errors
 (medians over the recordings not suspect, ratios of the medians, counts, suspect rows
-apart), the command on one shared motion (both links; skipped without the data), and the
-directory's default and refusal."""
+apart), the command on one shared motion (both links; skipped without the data), a
+recording whose accelerometer our filter could not use, and the directory's default and
+refusal."""
 
 from __future__ import annotations
 
@@ -93,4 +94,20 @@ def test_one_shared_motion_through_the_command(tmp_path, monkeypatch, capsys):
     ours, vqf = (float(r["total (°)"]) for f in FILTERS[:2] for r in long
                  if r["recording"] == names[0] and r["filter"] == f)
     assert float(first[5].split(" / ")[0]) == pytest.approx(ours / vqf, abs=0.006)
-    assert (tmp_path / "out" / "report.md").read_text(encoding="utf-8").count("circle-250") >= 4
+    report = (tmp_path / "out" / "report.md").read_text(encoding="utf-8")
+    assert report.count("circle-250") >= 4
+    assert "Accelerometer not used" not in report  # both start still: gravity measured
+
+
+@pytest.mark.skipif(not (_SHARED / "circle-150").is_dir(), reason=f"no OpenAXES data (${ENV})")
+def test_a_recording_whose_accelerometer_goes_unused_is_marked():
+    """circle-150-carpus starts in motion, never rests before its end and reads 3.4 % below
+    the nominal g: our filter skips its accelerometer updates and says so
+    (``AccelerometerUnusedWarning``), which the evaluation records instead of letting it
+    reach the terminal; circle-250-carpus starts still and is used."""
+    from strapdown.apps.ahrs_openaxes import evaluate
+
+    results, _ = evaluate(_SHARED, names=["circle-150-carpus", "circle-250-carpus"],
+                          filters=("strapdown EKF",))
+    assert results[("circle-150-carpus", "strapdown EKF")]["accelerometer_unused"] is True
+    assert results[("circle-250-carpus", "strapdown EKF")]["accelerometer_unused"] is False

@@ -6,6 +6,7 @@ post-processing); :class:`MeasurementFlag` says what each output did with its me
 """
 
 from strapdown.ahrs.filter import (
+    AccelerometerUnusedWarning,
     AhrsConfig,
     AhrsResult,
     attitude_from_acc_mag,
@@ -15,5 +16,5 @@ from strapdown.ahrs.filter import (
 )
 from strapdown.ahrs.flags import MeasurementFlag
 
-__all__ = ["AhrsConfig", "AhrsResult", "MeasurementFlag", "attitude_from_acc_mag", "ekf",
-           "offline_ekf", "start_is_still"]
+__all__ = ["AccelerometerUnusedWarning", "AhrsConfig", "AhrsResult", "MeasurementFlag",
+           "attitude_from_acc_mag", "ekf", "offline_ekf", "start_is_still"]

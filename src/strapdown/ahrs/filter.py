@@ -67,6 +67,7 @@ from __future__ import annotations
 
 import math
 import typing
+import warnings
 from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
@@ -76,8 +77,8 @@ from strapdown.ahrs import _kernel as K
 from strapdown.ahrs.flags import MeasurementFlag
 from strapdown.rotation.quaternion import quat_from_rotvec, quat_multiply
 
-__all__ = ["AhrsConfig", "AhrsResult", "attitude_from_acc_mag", "butterworth", "ekf",
-           "offline_ekf", "start_is_still", "window_bias_sigma"]
+__all__ = ["AccelerometerUnusedWarning", "AhrsConfig", "AhrsResult", "attitude_from_acc_mag",
+           "butterworth", "ekf", "offline_ekf", "start_is_still", "window_bias_sigma"]
 
 G = 9.80665
 #: The online hard-iron estimate's ridge, a fraction of the trace of its normal matrix: the
@@ -92,6 +93,19 @@ HI_RIDGE = 1e-3
 HI_UPDATE = 0.2
 #: q_NED_ENU: rotation by π about (1, 1, 0)/√2 (swaps x and y, flips z).
 Q_NED_ENU = np.array([0.0, math.sqrt(0.5), math.sqrt(0.5), 0.0])
+#: :class:`AccelerometerUnusedWarning` is raised when at least this share of the filter
+#: epochs skipped the low-pass accelerometer update as implausible (``ACC_DISTURBED``).
+ACC_UNUSED_SHARE = 0.5
+
+
+class AccelerometerUnusedWarning(UserWarning):
+    """The low-pass accelerometer model skipped most of its updates because the
+    accelerometer's norm disagrees with the gravity the filter assumed, which no rest
+    measured (a start in motion that never came to rest): the tilt there is the gyro's
+    alone. A norm short of it is an accelerometer scale error beyond
+    ``acc_lowpass_norm_tol`` (pass the gravity this accelerometer measures as
+    ``AhrsConfig(gravity=...)``); a long one may also be a sustained acceleration, which
+    the test is there to skip (a coordinated turn)."""
 
 
 @dataclass(frozen=True)
@@ -1140,10 +1154,12 @@ def ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
     cfg = config or AhrsConfig()
     rec, acc, mag, have_mag, q_init, b0, ref, start = _setup(t, gyro, acc, mag, cfg, q0,
                                                               gyro_bias0, mag_reference, frame)
-    out, epoch, _, offset, _ = _filter(rec, acc, mag, have_mag, cfg, algorithm, q_init, b0,
-                                       ref, start)
-    return replace(_result(rec, out, epoch, frame, have_mag, algorithm, cfg, start),
-                   mag_offset=offset if np.any(offset) else None)
+    out, epoch, gravity, offset, _ = _filter(rec, acc, mag, have_mag, cfg, algorithm, q_init,
+                                             b0, ref, start)
+    result = replace(_result(rec, out, epoch, frame, have_mag, algorithm, cfg, start),
+                     mag_offset=offset if np.any(offset) else None)
+    _warn_if_accelerometer_unused(result, acc, gravity, cfg, "ekf")
+    return result
 
 
 def _backward(rec, acc, mag, have_mag: bool, cfg: AhrsConfig, algorithm: str, fwd, ref,
@@ -1308,8 +1324,42 @@ def offline_ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
                        None if end_still else lowpass)
     _combine(fwd, bwd)
     _gyro_smooth(rec, fwd, cfg)
-    return replace(_result(rec, fwd, epoch, frame, have_mag, algorithm, cfg, start,
-                           smoothed=True), mag_offset=offset)
+    result = replace(_result(rec, fwd, epoch, frame, have_mag, algorithm, cfg, start,
+                             smoothed=True), mag_offset=offset)
+    _warn_if_accelerometer_unused(result, acc, gravity, cfg, "offline_ekf")
+    return result
+
+
+def _warn_if_accelerometer_unused(result: AhrsResult, acc, gravity: tuple[float, bool],
+                                  cfg: AhrsConfig, caller: str) -> None:
+    """Warn (:class:`AccelerometerUnusedWarning`) when the (forward) pass never measured
+    gravity's norm — no still start, no rest — and skipped at least ``ACC_UNUSED_SHARE``
+    of its low-pass accelerometer updates as implausible while the accelerometer's median
+    norm lies further from the assumed gravity than ``acc_lowpass_norm_tol``: the filter
+    then ran on the gyro alone, which its result would not show. ``acc``: the specific
+    force the filter was given (m/s²)."""
+    g, known = gravity
+    if known or not cfg.gating or cfg.acc_model != "lowpass":
+        return
+    share = result.fraction(MeasurementFlag.ACC_DISTURBED)
+    norm = float(np.median(np.linalg.norm(acc, axis=1)))
+    off = norm / g - 1.0
+    if share < ACC_UNUSED_SHARE or abs(off) <= cfg.acc_lowpass_norm_tol:
+        return
+    if off < 0.0:  # no motion keeps the low-passed specific force short for long
+        why = ("a scale error (or a wrong AhrsConfig.gravity): no sustained motion keeps the "
+               "low-passed specific force shorter than gravity")
+    else:
+        why = ("a sustained acceleration (a coordinated turn, which the test is there to "
+               "skip) or a scale error")
+    warnings.warn(
+        f"{caller}: {100 * share:.1f} % of the accelerometer updates were skipped and the "
+        f"tilt there is the gyro's alone: the record starts in motion, no rest measured "
+        f"gravity's norm, and the accelerometer's median norm {norm:.4g} m/s² is "
+        f"{100 * off:+.1f} % from the assumed {g:.6g} m/s² (AhrsConfig.gravity), beyond "
+        f"acc_lowpass_norm_tol ({100 * cfg.acc_lowpass_norm_tol:.1f} %) — {why}. If the "
+        f"accelerometer's scale is off, pass the gravity it measures as "
+        f"AhrsConfig(gravity=...).", AccelerometerUnusedWarning, stacklevel=3)
 
 
 def _hard_iron_offset(rec, mag, have_mag: bool, cfg: AhrsConfig) -> np.ndarray | None:

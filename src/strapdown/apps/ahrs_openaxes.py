@@ -30,13 +30,14 @@ from __future__ import annotations
 
 import math
 import os
+import warnings
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
 
-from strapdown.ahrs import ekf, offline_ekf
+from strapdown.ahrs import AccelerometerUnusedWarning, ekf, offline_ekf
 from strapdown.analysis.alignment import aligned_errors
 from strapdown.apps.ahrs_benchmark import KIND, FilterName, _available, vqf_attitude
 from strapdown.io.openaxes import (
@@ -88,8 +89,10 @@ def evaluate(directory: str | os.PathLike[str], *, names: Sequence[str] | None =
              progress: Callable[[str], None] | None = None) -> tuple[dict, dict]:
     """Each filter on each recording of ``directory`` (or those of ``names``).
 
-    Returns ``(results, suspects)``: ``{(recording, filter): aligned_errors(...)}`` (a
-    filter whose package is missing is skipped) and ``{recording: suspect_reason}`` in the
+    Returns ``(results, suspects)``: ``{(recording, filter): aligned_errors(...)}``, each
+    with ``"accelerometer_unused"``: whether the filter warned
+    :class:`~strapdown.ahrs.AccelerometerUnusedWarning` (a filter whose package is missing
+    is skipped) and ``{recording: suspect_reason}`` in the
     recordings' order."""
     say = progress or (lambda _m: None)
     found = list_openaxes(directory)
@@ -109,7 +112,16 @@ def evaluate(directory: str | os.PathLike[str], *, names: Sequence[str] | None =
         mask = rec.t >= settle_s
         for f in ran:
             say(f"{rec.name}: {f}")
-            results[(rec.name, f)] = aligned_errors(run_filter(f, rec), rec.q_ref, mask)
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always", AccelerometerUnusedWarning)
+                q = run_filter(f, rec)
+            e = aligned_errors(q, rec.q_ref, mask)
+            e["accelerometer_unused"] = any(
+                issubclass(w.category, AccelerometerUnusedWarning) for w in caught)
+            for w in caught:  # any other warning is the caller's, as before
+                if not issubclass(w.category, AccelerometerUnusedWarning):
+                    warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+            results[(rec.name, f)] = e
     return results, suspects
 
 
@@ -209,6 +221,17 @@ def openaxes(directory: str | os.PathLike[str], out: str | os.PathLike[str], *,
     md.append("## Total / inclination RMSE (°)\n\n" + table)
     md.append("\n## Suspect recordings (out of the medians)\n\n" + "".join(
         f"- `{n}`: {why}\n" for n, why in suspects.items() if why is not None))
+    unused: dict[str, list[str]] = {}
+    for (n, f), e in results.items():
+        if e.get("accelerometer_unused"):
+            unused.setdefault(n, []).append(f)
+    if unused:
+        md.append("\n## Accelerometer not used (`AccelerometerUnusedWarning`)\n\n"
+                  "These recordings start in motion and no rest measured gravity's norm; "
+                  "the accelerometer's norm lies beyond `acc_lowpass_norm_tol` from the "
+                  "nominal g, so our filter skipped most accelerometer updates and its tilt "
+                  "there is the gyro's alone:\n\n"
+                  + "".join(f"- `{n}`: {', '.join(f)}\n" for n, f in unused.items()))
     md.append("\n## Every filter: total, heading, inclination\n\n" + long)
     md.append(f"\nRun time {rep.elapsed():.0f} s.\n")
     rep.write("".join(md))
