@@ -1342,9 +1342,11 @@ def _warn_if_accelerometer_unused(result: AhrsResult, acc, gravity: tuple[float,
     if known or not cfg.gating or cfg.acc_model != "lowpass":
         return
     share = result.fraction(MeasurementFlag.ACC_DISTURBED)
+    if not share >= ACC_UNUSED_SHARE:  # the norms' median only when it may warn
+        return
     norm = float(np.median(np.linalg.norm(acc, axis=1)))
     off = norm / g - 1.0
-    if share < ACC_UNUSED_SHARE or abs(off) <= cfg.acc_lowpass_norm_tol:
+    if abs(off) <= cfg.acc_lowpass_norm_tol:
         return
     if off < 0.0:  # no motion keeps the low-passed specific force short for long
         why = ("a scale error (or a wrong AhrsConfig.gravity): no sustained motion keeps the "
