@@ -1289,7 +1289,9 @@ def offline_ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
     low-pass lag of one pass cancels the lead of the other, and the first seconds,
     where the forward filter is still converging, get the backward estimate (when the record
     ends in motion, the backward pass's accelerometer low-pass continues the forward pass's
-    and waits ``offline_lowpass_wait``); last, what
+    and waits ``offline_lowpass_wait``; when it ends still and the forward pass, started in
+    motion, never measured gravity's norm, that still end measures it for the backward pass,
+    as a still start does); last, what
     of the combination varies faster than ``offline_smooth_s`` about the bias-corrected
     gyro's own path is removed (zero-phase; :class:`AhrsConfig`). Before the passes, a
     hard-iron offset of the magnetometer found from the gyro over the whole record is
@@ -1320,6 +1322,10 @@ def offline_ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
     # a record that ends at rest: the backward pass's low-pass averages that rest afresh
     # (the forward pass's still lags the motion before it)
     end_still = _still(replace(rec, omega=rec.omega[::-1]), acc[::-1], cfg)
+    if end_still and not gravity[1]:
+        # the forward pass started moving and no rest measured gravity's norm; a still end
+        # measures it, as a still start does, for the backward pass, which starts there
+        gravity = (float(np.linalg.norm(acc[-_init_window(rec, cfg):].mean(axis=0))), True)
     bwd, _ = _backward(rec, acc, mag, have_mag, cfg_pass, algorithm, fwd, ref, gravity,
                        None if end_still else lowpass)
     _combine(fwd, bwd)
@@ -1332,12 +1338,12 @@ def offline_ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
 
 def _warn_if_accelerometer_unused(result: AhrsResult, acc, gravity: tuple[float, bool],
                                   cfg: AhrsConfig, caller: str) -> None:
-    """Warn (:class:`AccelerometerUnusedWarning`) when the (forward) pass never measured
-    gravity's norm — no still start, no rest — and skipped at least ``ACC_UNUSED_SHARE``
-    of its low-pass accelerometer updates as implausible while the accelerometer's median
-    norm lies further from the assumed gravity than ``acc_lowpass_norm_tol``: the filter
-    then ran on the gyro alone, which its result would not show. ``acc``: the specific
-    force the filter was given (m/s²)."""
+    """Warn (:class:`AccelerometerUnusedWarning`) when gravity's norm was never measured —
+    no still start, no rest, and (offline) no still end — and the (forward) pass skipped
+    at least ``ACC_UNUSED_SHARE`` of its low-pass accelerometer updates as implausible
+    while the accelerometer's median norm lies further from the assumed gravity than
+    ``acc_lowpass_norm_tol``: the filter then ran on the gyro alone, which its result
+    would not show. ``acc``: the specific force the filter was given (m/s²)."""
     g, known = gravity
     if known or not cfg.gating or cfg.acc_model != "lowpass":
         return
