@@ -240,8 +240,9 @@ class Initial(NamedTuple):
     low-pass model's initial state (4,), NaN for none (the low-pass then averages its
     first ``lp_init_n`` epochs): the low-passed specific force in the reference frame and
     the motion power through it (:func:`_motion_power`), as :func:`ekf_kernel` returns
-    them; and the epochs before the low-pass model's first update unless the
-    accelerometer is quiet (0: none)."""
+    them — the power may be given alone (a start in motion's, the filter's
+    ``_start_motion_power``; 0 when NaN); and the epochs before the low-pass model's first
+    update unless the accelerometer is quiet (0: none)."""
 
     q: np.ndarray
     gyro_bias: np.ndarray
@@ -1510,7 +1511,8 @@ def ekf_kernel(sensors, prop, window, params, init, out):
     ref_heading = params.ref_heading
     refer = 0
     # moving mean square of the motion acceleration through the low-pass
-    dyn2 = init.lowpass[3] if lp_n > 0 else 0.0
+    # (a start in motion's, or a carried one; Initial.lowpass[3])
+    dyn2 = init.lowpass[3] if np.isfinite(init.lowpass[3]) else 0.0
     lp2 = np.zeros(3)  # slow mean of the low-passed specific force
     if lp_n > 0:  # an initial low-pass (Initial.lowpass) is its slow mean's start too
         for a in range(3):

@@ -41,12 +41,13 @@ with the accelerometer and magnetometer handling of Laidig & Seel (2023)):
 - **initial attitude** from the mean accelerometer and magnetometer over
   ``init_window_s`` (TRIAD) when none is given; the reference field (norm, dip,
   heading) is learned there too, unless given. A window that is not still (the rest
-  detector's statistics, :func:`start_is_still`) is a **start in motion**: its samples
-  are turned into the first sample's body frame by the gyro before they are averaged,
-  the initial attitude uncertainty is ``moving_start_sigma0``, the low-pass
-  accelerometer model waits for its low-pass to settle, the field's reference norm and
-  dip follow the measurement for ``moving_start_mag_s``, and gravity's norm is the
-  nominal one until the first rest measures it.
+  detector's statistics, :func:`start_is_still`) is a **start in motion**: the samples
+  of its own window (``moving_start_window_s``) are turned into the first sample's body
+  frame by the gyro before they are averaged, their motion sets the low-pass model's
+  initial motion power, the initial attitude uncertainty is ``moving_start_sigma0``, the
+  low-pass accelerometer model waits for its low-pass to settle, the field's reference
+  norm and dip follow the measurement for ``moving_start_mag_s``, and gravity's norm is
+  the nominal one until the first rest measures it.
 
 :func:`ekf` is causal (one pass, no sample after the estimate's own is used);
 :func:`offline_ekf` adds a backward pass and combines the two (Fraser & Potter
@@ -454,6 +455,18 @@ class AhrsConfig:
         metres per second over half a second: tens of degrees of tilt, and through the
         field's dip more of heading). Default 0.3. With 0.05 every later measurement
         failed the gates: simulated records cut in motion ended 12–350 times VQF's error.
+    moving_start_window_s : float
+        The window over which a start in motion averages its specific force and field,
+        turned into the first sample's frame by the gyro, for the initial attitude, s
+        (whether the start is still is decided over ``init_window_s``). Its motion
+        acceleration also sets the low-pass model's initial motion power (``ā²`` of
+        ``acc_motion_leak``): the mean square of the window's specific force across its
+        mean, so the first low-passed measurements of a start in motion are weighed by the
+        motion the window showed instead of as if it were still. The mean's error is the
+        motion's ``Δv/T``: a 70° swing of a 0.3 m pendulum (period 1.1 s) moved the
+        half-second window's mean by tens of degrees. Default 1 (0.5, 1, 2 and 3 s were
+        compared on simulated records cut in motion and BROAD's trials cut in motion;
+        docs/reproductions.md).
     moving_start_mag_s : float
         After a start in motion, the magnetometer's reference norm and dip follow the
         measurement for this long, s: the dip is measured with the estimated tilt, wrong
@@ -534,6 +547,7 @@ class AhrsConfig:
     attitude_sigma0: float = 0.05
     moving_start_sigma0: float = 0.3
     moving_start_mag_s: float = 5.0
+    moving_start_window_s: float = 1.0
     declination_deg: float = 0.0
     gravity: float = G
 
@@ -758,6 +772,30 @@ def _init_window(rec, cfg: AhrsConfig) -> int:
     return max(2, min(rec.t.size, round(cfg.init_window_s / rec.td)))
 
 
+def _moving_window(rec, cfg: AhrsConfig) -> int:
+    """Samples of a start in motion's window (``moving_start_window_s``; at least 2, at
+    most the record)."""
+    return max(2, min(rec.t.size, round(cfg.moving_start_window_s / rec.td)))
+
+
+def _start_motion_power(rec, acc, cfg: AhrsConfig) -> float:
+    """A start in motion's initial motion power for the low-pass model (``_kernel``'s
+    ``dyn2``, m²/s⁴): over ``moving_start_window_s``, the specific force turned into the
+    first sample's frame, its mean square across its mean's direction,
+    ``tr(S) − uᵀ S u`` with ``S`` the window's mean of ``f fᵀ`` and ``u`` the unit mean
+    (the raw motion, an upper bound of what the low-pass lets through; the kernel's moving
+    mean square then follows the low-passed motion with time constant ``acc_lowpass_s``).
+    0 when the mean is zero."""
+    a = _derotated(rec, acc, _moving_window(rec, cfg))
+    m = a.mean(axis=0)
+    n = float(np.linalg.norm(m))
+    if not n > 0.0:
+        return 0.0
+    u = m / n
+    S = a.T @ a / a.shape[0]
+    return max(0.0, float(np.trace(S) - u @ S @ u))
+
+
 def start_is_still(t, gyro, acc, config: AhrsConfig | None = None) -> bool:
     """Whether a record's initial window (``init_window_s``) is still, as the filter
     decides it: the rest detector's statistics over the window — the gyro's variance
@@ -800,7 +838,7 @@ def _initial_attitude(rec, acc, mag, have_mag: bool, cfg: AhrsConfig, q0, frame:
     average over the rotation: a 1.5 Hz spin turns 270° in half a second).
     """
     if q0 is None:
-        w = _init_window(rec, cfg)
+        w = _init_window(rec, cfg) if still else _moving_window(rec, cfg)
         a = acc[:w] if still else _derotated(rec, acc, w)
         m0 = None
         if have_mag:
@@ -1097,9 +1135,13 @@ def _filter(rec, acc, mag, have_mag: bool, cfg: AhrsConfig, algorithm: str, q_in
         from strapdown.rotation.dcm import dcm_from_quat
 
         up = dcm_from_quat(q_init)[2]  # the reference vertical in the body: C_n_b's third row
+    if lowpass is None:  # a start in motion: the low-pass averages, the motion power is set
+        lowpass = np.full(4, np.nan)
+        if not start.still and cfg.acc_model == "lowpass":
+            lowpass[3] = _start_motion_power(rec, acc, cfg)
     init = K.Initial(q_init, b0, _initial_covariance(cfg, start.attitude_sigma0, up,
                                                      start.gyro_bias_sigma0),
-                     np.full(4, np.nan) if lowpass is None else np.asarray(lowpass, float),
+                     np.asarray(lowpass, float),
                      math.ceil(lowpass_wait_s / (prop.stride * rec.td) - 1e-9))
     params = _params(cfg, ref, have_mag, rec.td, prop.stride * rec.td, start)._replace(
         store_covariance=store_covariance)

@@ -161,7 +161,8 @@ def _run_ahrs(args: argparse.Namespace) -> int:
                     mag=not args.no_mag, algorithm=args.propagation, config=_ahrs_config(args),
                     name=args.name)
     print(_wrote(args.out, e.name))
-    print(f"initial window: {e.init_samples} samples (init_window_s)")
+    print(f"initial window: {e.init_samples} samples (init_window_s); a start in motion's: "
+          f"{e.moving_samples} (moving_start_window_s)")
     if args.no_count:
         return 0
     from strapdown.codegen.ahrs_count import count_operations, state_size

@@ -5,7 +5,8 @@ The C (``templates/ahrs.c.in``, ``templates/ahrs.h.in``) mirrors
 names the kernel function it repeats; the covariance updates use P's symmetry and zero
 blocks, so the arithmetic differs at round-off (see the template's head) — and runs the
 causal filter of :func:`strapdown.ahrs.ekf` one sample at a time: the initial window
-(``init_window_s``) is buffered, its means give the initial attitude, the reference
+(``init_window_s``; when it is not still, a start in motion's ``moving_start_window_s``)
+is buffered, its means give the initial attitude, the reference
 field and gravity as the library computes them, then the buffered samples and every
 later one go through the same epochs. In double precision it equals the library to
 round-off (the test suite holds it to 1e-8 rad at every sample on BROAD recordings).
@@ -60,6 +61,7 @@ class AhrsExport:
     algorithm: str
     config: AhrsConfig
     init_samples: int
+    moving_samples: int  #: a start in motion's window, samples (moving_start_window_s)
 
 
 def _lit(x: float, real: str) -> str:
@@ -115,13 +117,21 @@ def _table(name: str, ctype: str, values, fmt) -> str:
     return f"static const {ctype} {name}[{len(vals)}] = {{{', '.join(fmt(v) for v in vals)}}};"
 
 
-def _sizes(cfg: AhrsConfig, params: K.Params, prop: dict, mag: bool, n_init: int) -> dict:
+def _moving_samples(cfg: AhrsConfig, h: float) -> int:
+    """A start in motion's window, samples (filter._moving_window)."""
+    return max(2, round(cfg.moving_start_window_s / h))
+
+
+def _sizes(cfg: AhrsConfig, params: K.Params, prop: dict, mag: bool, n_init: int,
+           n_move: int) -> dict:
     """The header's size macros (without the prefix)."""
     stride = int(prop["stride"])
+    n_win = max(n_init, n_move)
     dmax = (params.mag_delay_max if params.estimate_mag_delay else params.mag_delay) if mag else 0
     max_off = int(np.max(prop["offsets"])) if len(prop["offsets"]) else 2
     return {"NX": 6 + 3 * (cfg.acc_model == "raw") + 3 * cfg.estimate_acc_bias,
-            "INIT_SAMPLES": n_init, "MAG_WINDOW": n_init if mag else 1,
+            "INIT_SAMPLES": n_init, "MOVING_SAMPLES": n_move, "WIN_SAMPLES": n_win,
+            "MAG_WINDOW": n_win if mag else 1,
             # the gyro history: a power of two, so that k % XH is a mask
             "XH": 1 << (max(max_off + 1, dmax + 2, 3) - 1).bit_length(), "DMAX": dmax,
             "ND": (dmax + stride // 2) // stride + 1 if mag else 1}
@@ -236,8 +246,9 @@ def generate_ahrs(sample_rate_hz: float | None = None, *, h: float | None = None
     prop = propagation_supported(algorithm)
     params = _params(cfg, mag, h, int(prop["stride"]))
     n_init = max(2, round(cfg.init_window_s / h))
+    n_move = _moving_samples(cfg, h)
     sizes = "\n".join(f"#define PREFIX_{k} {v}" for k, v in
-                      _sizes(cfg, params, prop, mag, n_init).items())
+                      _sizes(cfg, params, prop, mag, n_init, n_move).items())
     header = (_TEMPLATES / "ahrs.h.in").read_text().replace("@SIZES@", sizes).replace(
         "@INFO@", _info(cfg, algorithm, h, mag, real)).replace("typedef REAL", f"typedef {real}")
     header = header.replace("GUARD", name.upper() + "_H_INCLUDED")
@@ -246,7 +257,7 @@ def generate_ahrs(sample_rate_hz: float | None = None, *, h: float | None = None
         body = _to_float(body)
     source = body.replace("@CONSTANTS@", _constants(cfg, params, prop, h, mag, real, n_init))
     return AhrsExport(name, _fill(header, name), _fill(source, name), real, h, mag,
-                      algorithm, cfg, n_init)
+                      algorithm, cfg, n_init, n_move)
 
 
 def export_ahrs(out: str | Path, **kwargs) -> AhrsExport:
