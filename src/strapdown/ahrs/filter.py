@@ -466,8 +466,8 @@ class AhrsConfig:
         still. The mean's error is the
         motion's ``Δv/T``: a 70° swing of a 0.3 m pendulum (period 1.1 s) moved the
         half-second window's mean by tens of degrees. Default 1 (0.5, 1, 2 and 3 s were
-        compared on simulated records cut in motion and BROAD's trials cut in motion;
-        docs/reproductions.md).
+        compared on the simulated records cut in motion, without the motion power; 0.5 and
+        1 s also on BROAD's trials cut in motion; docs/reproductions.md).
     moving_start_mag_s : float
         After a start in motion, the magnetometer's reference norm and dip follow the
         measurement for this long, s: the dip is measured with the estimated tilt, wrong
