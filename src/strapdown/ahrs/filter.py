@@ -463,11 +463,11 @@ class AhrsConfig:
         ``acc_motion_leak``; ``_start_motion_power``: the change of the mean from the
         window's first half to its second), so the first low-passed measurements of a start
         in motion are weighed by the motion the window showed instead of as if it were
-        still. The mean's error is the
-        motion's ``Δv/T``: a 70° swing of a 0.3 m pendulum (period 1.1 s) moved the
-        half-second window's mean by tens of degrees. Default 1 (0.5, 1, 2 and 3 s were
-        compared on the simulated records cut in motion, without the motion power; 0.5 and
-        1 s also on BROAD's trials cut in motion; docs/reproductions.md).
+        still. The mean's error is the motion's ``Δv/T``: a 70° swing of a 0.3 m pendulum
+        (period 1.1 s) moved the half-second window's mean by tens of degrees. Default 1
+        (0.5, 1, 2 and 3 s were compared on the simulated records cut in motion, without
+        the motion power; 0.5 and 1 s also on BROAD's trials cut in motion;
+        docs/reproductions.md).
     moving_start_mag_s : float
         After a start in motion, the magnetometer's reference norm and dip follow the
         measurement for this long, s: the dip is measured with the estimated tilt, wrong
@@ -1140,7 +1140,8 @@ def _filter(rec, acc, mag, have_mag: bool, cfg: AhrsConfig, algorithm: str, q_in
         from strapdown.rotation.dcm import dcm_from_quat
 
         up = dcm_from_quat(q_init)[2]  # the reference vertical in the body: C_n_b's third row
-    if lowpass is None:  # a start in motion: the low-pass averages, the motion power is set
+    if lowpass is None:  # none carried: the low-pass averages its first epochs, and a start
+        # in motion's motion power is what its window showed
         lowpass = np.full(4, np.nan)
         if not start.still and cfg.acc_model == "lowpass":
             lowpass[3] = _start_motion_power(rec, acc, cfg)
