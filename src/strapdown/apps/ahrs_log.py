@@ -541,8 +541,8 @@ def _metadata(imu: Path, log: AhrsLog, res: AhrsResult, algorithm: str, frame: s
                               else 0.0),
         "rest_updates": res.fraction(MeasurementFlag.REST),
         "start": ("still" if res.start_still else "in motion (the initial window is not still: "
-                  "averaged along the gyro, wider initial uncertainty, gravity's norm nominal "
-                  "until the first rest)"),
+                  "moving_start_window_s averaged along the gyro, wider initial uncertainty, "
+                  "gravity's norm nominal until the first rest)"),
         "mag_hard_iron_subtracted": (None if res.mag_offset is None
                                      else [float(x) for x in res.mag_offset]),
         "gyro_units": log.gyro_units, "acc_units": log.acc_units,
