@@ -103,3 +103,31 @@ def test_a_start_in_motion_is_said_and_in_the_metadata(tmp_path, capsys):
         meta = json.loads(out.with_name(out.name + ".meta.json").read_text())
         assert ("starts in motion" in err) is not still
         assert meta["start"].startswith("still" if still else "in motion")
+
+
+def test_an_unused_accelerometer_is_said_on_stderr_and_in_the_metadata(tmp_path, capsys):
+    """A 6-axis log that starts spinning and never rests, its accelerometer 3.5 % low: the
+    filter skips every accelerometer update (gravity's norm never measured), and the
+    command says so — a ``warning:`` line naming the norm, the same text in
+    ``OUT.meta.json``'s warnings, and "accelerometer used 0%" in its summary."""
+    import json
+
+    import numpy as np
+
+    t = np.arange(2000) * 0.01
+    rows = np.column_stack([t, np.zeros_like(t), np.zeros_like(t), np.full_like(t, 0.5),
+                            np.zeros_like(t), np.zeros_like(t),
+                            np.full_like(t, 0.965 * 9.80665)])
+    imu = tmp_path / "spin.csv"
+    imu.write_text("t,gx,gy,gz,ax,ay,az\n"
+                   + "".join(",".join(f"{v:.6f}" for v in r) + "\n" for r in rows))
+    out = tmp_path / "att.csv"
+    code = main(["ahrs", "--imu", str(imu), "--gyro-units", "rad/s", "--acc-units", "m/s2",
+                 "--out", str(out)])
+    cap = capsys.readouterr()
+    assert code in (0, None), cap.err
+    said = [ln for ln in cap.err.splitlines() if ln.startswith("warning: ekf:")]
+    assert len(said) == 1 and "-3.5 %" in said[0] and "AhrsConfig(gravity=" in said[0]
+    meta = json.loads((tmp_path / "att.csv.meta.json").read_text())
+    assert any("accelerometer updates were skipped" in w for w in meta["warnings"])
+    assert meta["accelerometer_used"] == 0.0 and "accelerometer used 0%" in cap.out
