@@ -240,8 +240,8 @@ class Initial(NamedTuple):
     low-pass model's initial state (4,), NaN for none (the low-pass then averages its
     first ``lp_init_n`` epochs): the low-passed specific force in the reference frame and
     the motion power through it (:func:`_motion_power`), as :func:`ekf_kernel` returns
-    them — the power may be given alone (a start in motion's, the filter's
-    ``_start_motion_power``; 0 when NaN); and the epochs before the low-pass model's first
+    them — the power may be given alone (the filter's ``_Start.motion_power``; 0 when
+    NaN); and the epochs before the low-pass model's first
     update unless the accelerometer is quiet (0: none)."""
 
     q: np.ndarray
@@ -1604,9 +1604,10 @@ def ekf_kernel(sensors, prop, window, params, init, out):
                                                     kk, S2, Si2)
                     else:
                         nis_acc, ok = _gated_update(P, H_lp, 3 if nx == 6 else nx,
-                                                _lowpass_variance(params, dyn2, T), y2,
-                                                params.acc_gate_lowpass, params.gating, force,
-                                                params.soft_gate, dx, U2, S2, Si2)
+                                                    _lowpass_variance(params, dyn2, T), y2,
+                                                    params.acc_gate_lowpass, params.gating,
+                                                    force, params.soft_gate, dx, U2, S2,
+                                                    Si2)
             else:
                 disturbed = not _acc_plausible(fk, params)
                 ok = False

@@ -1061,9 +1061,10 @@ def _result(rec, out: K.Outputs, epoch, frame: str, have_mag: bool, algorithm: s
 class _Start(typing.NamedTuple):
     """How a pass starts: the initial window still (else a start in motion); gravity's
     norm as this accelerometer measures it — measured (``gravity_known``) or, after a
-    start in motion, the nominal one until a rest measures it; and, after a start in
-    motion whose attitude comes from the window, its wider initial uncertainty and the
-    time the field's reference follows the measurement (0: not at all)."""
+    start in motion, the nominal one until a rest measures it; after a start in motion
+    whose attitude comes from the window, its wider initial uncertainty and the time the
+    field's reference follows the measurement (0: not at all); and the low-pass model's
+    initial motion power (a start in motion's, :func:`_start_motion_power`; else 0)."""
 
     still: bool
     gravity: float
@@ -1071,6 +1072,7 @@ class _Start(typing.NamedTuple):
     attitude_sigma0: float
     mag_provisional_s: float = 0.0
     gyro_bias_sigma0: float | None = None  #: None: the config's
+    motion_power: float = 0.0
 
 
 def _start(rec, acc, cfg: AhrsConfig, q0, mag_reference) -> _Start:
@@ -1081,10 +1083,12 @@ def _start(rec, acc, cfg: AhrsConfig, q0, mag_reference) -> _Start:
     if _still(rec, acc, cfg):
         return _Start(True, float(np.linalg.norm(acc[:_init_window(rec, cfg)].mean(axis=0))),
                       True, cfg.attitude_sigma0)
+    power = _start_motion_power(rec, acc, cfg) if cfg.acc_model == "lowpass" else 0.0
     if q0 is not None:
-        return _Start(False, float(cfg.gravity), False, cfg.attitude_sigma0)
+        return _Start(False, float(cfg.gravity), False, cfg.attitude_sigma0,
+                      motion_power=power)
     return _Start(False, float(cfg.gravity), False, cfg.moving_start_sigma0,
-                  cfg.moving_start_mag_s if mag_reference is None else 0.0)
+                  cfg.moving_start_mag_s if mag_reference is None else 0.0, motion_power=power)
 
 
 def _setup(t, gyro, acc, mag, cfg: AhrsConfig, q0, gyro_bias0, mag_reference, frame):
@@ -1140,11 +1144,8 @@ def _filter(rec, acc, mag, have_mag: bool, cfg: AhrsConfig, algorithm: str, q_in
         from strapdown.rotation.dcm import dcm_from_quat
 
         up = dcm_from_quat(q_init)[2]  # the reference vertical in the body: C_n_b's third row
-    if lowpass is None:  # none carried: the low-pass averages its first epochs, and a start
-        # in motion's motion power is what its window showed
-        lowpass = np.full(4, np.nan)
-        if not start.still and cfg.acc_model == "lowpass":
-            lowpass[3] = _start_motion_power(rec, acc, cfg)
+    if lowpass is None:  # none carried: the low-pass averages its first epochs
+        lowpass = np.array([np.nan, np.nan, np.nan, start.motion_power])
     init = K.Initial(q_init, b0, _initial_covariance(cfg, start.attitude_sigma0, up,
                                                      start.gyro_bias_sigma0),
                      np.asarray(lowpass, float),
