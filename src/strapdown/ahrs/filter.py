@@ -822,15 +822,23 @@ def _still(rec, acc, cfg: AhrsConfig) -> bool:
                 and np.sum(np.var(a, axis=0)) < cfg.rest_acc ** 2)
 
 
-def _derotated(rec, x, w: int, q0=None) -> np.ndarray:
-    """The first ``w`` rows of ``x`` (body-frame vectors) turned along the gyro's attitude
-    (``rate-single``) from the first sample into the frame that ``q0`` (default: identity,
-    the first sample's body frame) relates the first sample to."""
+def _window_path(rec, w: int, q0=None) -> np.ndarray:
+    """The gyro's attitude (``rate-single``) over the first ``w`` samples as DCMs (w, 3, 3),
+    from the first sample into the frame that ``q0`` (default: identity, the first
+    sample's body frame) relates the first sample to."""
     from strapdown.algorithms.rate import rate_attitude
     from strapdown.rotation.dcm import dcm_from_quat
 
-    q = rate_attitude(rec.t[:w], rec.omega[:w], algorithm="rate-single", q0=q0).q
-    return np.einsum("nij,nj->ni", dcm_from_quat(q), x[:w])
+    return dcm_from_quat(rate_attitude(rec.t[:w], rec.omega[:w], algorithm="rate-single",
+                                       q0=q0).q)
+
+
+def _derotated(rec, x, w: int, q0=None, path=None) -> np.ndarray:
+    """The first ``w`` rows of ``x`` (body-frame vectors) turned along the gyro's attitude
+    (:func:`_window_path`; ``path``: that path, already computed for the same ``w`` and
+    ``q0``)."""
+    c = _window_path(rec, w, q0) if path is None else path
+    return np.einsum("nij,nj->ni", c, x[:w])
 
 
 def _initial_attitude(rec, acc, mag, have_mag: bool, cfg: AhrsConfig, q0, frame: str,
@@ -844,10 +852,11 @@ def _initial_attitude(rec, acc, mag, have_mag: bool, cfg: AhrsConfig, q0, frame:
     """
     if q0 is None:
         w = _init_window(rec, cfg) if still else _moving_window(rec, cfg)
-        a = acc[:w] if still else _derotated(rec, acc, w)
+        path = None if still else _window_path(rec, w)  # one gyro path for both sensors
+        a = acc[:w] if still else _derotated(rec, acc, w, path=path)
         m0 = None
         if have_mag:
-            m0 = (mag[:w] if still else _derotated(rec, mag, w)).mean(axis=0)
+            m0 = (mag[:w] if still else _derotated(rec, mag, w, path=path)).mean(axis=0)
         return attitude_from_acc_mag(a.mean(axis=0), m0,
                                      declination_deg=cfg.declination_deg), m0
     q_init = as_quaternions(q0, "q0").reshape(4)
