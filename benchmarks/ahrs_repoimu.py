@@ -1,7 +1,7 @@
 """Real swinging bodies: RepoIMU's three-segment pendulum, our filter against VQF.
 
 Usage: ``python benchmarks/ahrs_repoimu.py DIR [--timing uniform|resample] [--glob PATTERN]
-[--set NAME=VALUE ...] [--jobs 2] [--out FILE]``
+[--set FIELD=VALUE ...] [--jobs 2] [--out FILE]``
 
 DIR holds the pendulum recordings of RepoIMU (Szczęsna et al. (2016), the public repository
 ``agnieszkaszczesna/RepoIMU``, folder ``Pendulum``: ``Pendulum_TestNN_TrialM_Segment_S.csv``,
@@ -35,6 +35,8 @@ from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
+
+from strapdown.cli._common import ahrs_config_fields
 
 DEFAULT_GLOB = "Pendulum_Test0[2-8]*_Segment_*.csv"
 FILTERS = ("strapdown EKF", "VQF", "strapdown EKF offline", "offlineVQF")
@@ -85,32 +87,23 @@ def evaluate(path: Path, timing: str, config: dict) -> tuple[str, dict[str, floa
     return path.stem, {f: aligned_errors(qs[f], r["q_ref"])["total_deg"] for f in FILTERS}
 
 
-def _value(text: str):
-    try:
-        return json.loads(text)
-    except json.JSONDecodeError:
-        return text
-
-
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0], allow_abbrev=False)
     ap.add_argument("dir", type=Path, help="RepoIMU's Pendulum folder")
     ap.add_argument("--timing", choices=["uniform", "resample"], default="uniform")
     ap.add_argument("--glob", default=DEFAULT_GLOB)
-    ap.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
-                    help="an AhrsConfig field for our filter (repeatable)")
+    ap.add_argument("--set", action="append", default=[], metavar="FIELD=VALUE",
+                    help="an AhrsConfig field for our filter (repeatable; default: none)")
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--out", type=Path, default=None, help="write every figure as JSON here")
     args = ap.parse_args(argv)
     files = sorted(args.dir.glob(args.glob))
     if not files:
         ap.error(f"no {args.glob} in {args.dir}")
-    config = {}
-    for item in args.set:
-        name, sep, value = item.partition("=")
-        if not sep:
-            ap.error(f"--set takes NAME=VALUE, got {item!r}")
-        config[name] = _value(value)
+    try:
+        config = ahrs_config_fields(args.set)
+    except ValueError as e:
+        ap.error(str(e))
     with ProcessPoolExecutor(args.jobs) as ex:
         rows = list(ex.map(evaluate, files, [args.timing] * len(files),
                            [config] * len(files)))

@@ -22,6 +22,7 @@ __all__ = [
     "CommandParser",
     "HelpFormatter",
     "Parser",
+    "ahrs_config_fields",
     "algorithm_help",
     "coefficients_help",
     "columns",
@@ -121,6 +122,32 @@ class CommandParser(Parser):
 
 
 # ------------------------------------------------------------------------------ output
+def ahrs_config_fields(items: Iterable[str]) -> dict[str, Any]:
+    """``--set FIELD=VALUE`` items as AhrsConfig keyword arguments, each value parsed as
+    its field's type (bool: true/false/1/0; str; else float). Raises ValueError naming the
+    item on one that is not FIELD=VALUE with an AhrsConfig field, or a bad bool."""
+    import dataclasses
+
+    from strapdown.ahrs import AhrsConfig
+
+    fields = [f.name for f in dataclasses.fields(AhrsConfig)]
+    defaults = AhrsConfig()
+    kw: dict[str, Any] = {}
+    for item in items:
+        key, sep, value = item.partition("=")
+        if not sep or key not in fields:
+            raise ValueError(f"--set {item!r}: expected FIELD=VALUE with an AhrsConfig field "
+                             f"({', '.join(fields)})")
+        default = getattr(defaults, key)
+        if isinstance(default, bool):
+            if value.lower() not in ("true", "false", "1", "0"):
+                raise ValueError(f"--set {key}: expected true or false, got {value!r}")
+            kw[key] = value.lower() in ("true", "1")
+        else:
+            kw[key] = value if isinstance(default, str) else float(value)
+    return kw
+
+
 def say(msg: str) -> None:
     """One line on stderr (progress and warnings; stdout carries the results)."""
     print(msg, file=sys.stderr)

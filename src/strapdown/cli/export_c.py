@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from strapdown.cli._common import coefficients_help, structure_help
+from strapdown.cli._common import ahrs_config_fields, coefficients_help, structure_help
 
 __all__ = ["add_parser", "run"]
 
@@ -123,26 +123,10 @@ def run(args: argparse.Namespace) -> int:
 
 def _ahrs_config(args: argparse.Namespace):
     """The AhrsConfig of the options (``--set`` values parsed as the field's type)."""
-    import dataclasses
-
     from strapdown.ahrs import AhrsConfig
 
-    fields = {f.name: f for f in dataclasses.fields(AhrsConfig)}
-    kw: dict = {"gating": not args.no_gating, "declination_deg": args.declination_deg,
-                "gyro_sample": args.gyro_sample}
-    for item in args.config:
-        key, sep, value = item.partition("=")
-        if not sep or key not in fields:
-            raise ValueError(f"--set {item!r}: expected FIELD=VALUE with an AhrsConfig field "
-                             f"({', '.join(fields)})")
-        default = getattr(AhrsConfig(), key)
-        if isinstance(default, bool):
-            if value.lower() not in ("true", "false", "1", "0"):
-                raise ValueError(f"--set {key}: expected true or false, got {value!r}")
-            kw[key] = value.lower() in ("true", "1")
-        else:
-            kw[key] = value if isinstance(default, str) else float(value)
-    return AhrsConfig(**kw)
+    return AhrsConfig(**{"gating": not args.no_gating, "declination_deg": args.declination_deg,
+                         "gyro_sample": args.gyro_sample, **ahrs_config_fields(args.config)})
 
 
 def _run_ahrs(args: argparse.Namespace) -> int:
