@@ -2,13 +2,15 @@
 figures per left-out kind (issue 25).
 
 Usage: ``python benchmarks/ahrs_cv_kinds.py BROAD_DIR [--seed 0] [--out
-reports/ahrs_cv_kinds.json] [--jobs 2]``.
+reports/ahrs_cv_kinds.json] [--jobs 2] [--gyro-scale SD] [--gyro-misalignment SD]``.
 
 The kinds: BROAD's trial groups (``benchmarks/ahrs_cv.py``'s :func:`groups`: undisturbed
 trials by motion, disturbed ones by disturbance — five on the fifteen shared trials) and
 the simulated scenario kinds of the generalisation suite (``strapdown.truth.scenarios``:
 pendulum, vehicle, loiter, spin-coning, hand-held, steel-frame, rests), recorded with the
-sensor errors of ``--seed``. Every candidate of :data:`GRID` runs once, causally, on every
+sensor errors of ``--seed`` (and, with ``--gyro-scale`` / ``--gyro-misalignment``, a gyro
+scale-factor and cross-axis error of that standard deviation, ``Sensors.gyro_scale_sd``:
+the study on consumer gyros that are not calibrated). Every candidate of :data:`GRID` runs once, causally, on every
 recording. A fold leaves one kind out and picks the candidate best on the other kinds; the
 left-out kind is then scored with it, causally and offline. The defaults are the candidate
 best on every kind.
@@ -64,7 +66,8 @@ PRIOR = {"gyro_noise": 1.4e-3, "heading_noise": 0.0126, "tilt_rate_noise": 4.2e-
 class Data:
     """Every recording of the study, its kind and VQF's causal and offline errors."""
 
-    def __init__(self, broad_dir: Path, seed: int):
+    def __init__(self, broad_dir: Path, seed: int, gyro_scale: float = 0.0,
+                 gyro_misalignment: float = 0.0):
         from strapdown.apps.ahrs_generalisation import trial
         from strapdown.io.broad import read_broad
         from strapdown.truth.scenarios import record, suite
@@ -74,6 +77,8 @@ class Data:
         self.kind = {tr.name: "broad:" + group_of[tr.name] for tr in self.trials}
         self.six_axis: set[str] = set()
         for k, sc in enumerate(suite(seed)):
+            sc = replace(sc, sensors=replace(sc.sensors, gyro_scale_sd=gyro_scale,
+                                             gyro_misalignment_sd=gyro_misalignment))
             tr = trial(record(sc, np.random.SeedSequence([seed, k])))
             self.trials.append(tr)
             self.kind[tr.name] = "sim:" + sc.name.split("-")[0]
@@ -143,9 +148,10 @@ def objective(ratios: dict[str, float], kinds) -> float:
 _DATA: Data | None = None
 
 
-def _init(broad_dir: str, seed: int) -> None:
+def _init(broad_dir: str, seed: int, gyro_scale: float = 0.0,
+          gyro_misalignment: float = 0.0) -> None:
     global _DATA
-    _DATA = Data(Path(broad_dir), seed)
+    _DATA = Data(Path(broad_dir), seed, gyro_scale, gyro_misalignment)
 
 
 def _candidate(config: dict) -> tuple[dict, dict[str, float]]:
@@ -165,12 +171,17 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--out", type=Path, default=Path("reports/ahrs_cv_kinds.json"))
     p.add_argument("--jobs", type=int, default=2)
+    p.add_argument("--gyro-scale", type=float, default=0.0,
+                   help="the simulated gyros' scale-factor error, standard deviation")
+    p.add_argument("--gyro-misalignment", type=float, default=0.0,
+                   help="their cross-axis sensitivity, standard deviation")
     a = p.parse_args(argv)
-    _init(str(a.dir), a.seed)
+    init = (str(a.dir), a.seed, a.gyro_scale, a.gyro_misalignment)
+    _init(*init)
     assert _DATA is not None
     kinds = _DATA.kinds
     cands = [dict(zip(GRID, v, strict=True)) for v in itertools.product(*GRID.values())]
-    with ProcessPoolExecutor(a.jobs, initializer=_init, initargs=(str(a.dir), a.seed)) as ex:
+    with ProcessPoolExecutor(a.jobs, initializer=_init, initargs=init) as ex:
         table = list(ex.map(_candidate, cands))
     folds = {}
     for held in kinds:
@@ -183,7 +194,8 @@ def main(argv: list[str] | None = None) -> int:
     for k, cfg in folds.items():
         c, o = _scores(_DATA, cfg, [k])
         held_c[k], held_o[k] = c[k], o[k]
-    report = {"seed": a.seed, "grid": GRID, "prior": PRIOR, "defaults": defaults,
+    report = {"seed": a.seed, "gyro_scale": a.gyro_scale,
+              "gyro_misalignment": a.gyro_misalignment, "grid": GRID, "prior": PRIOR, "defaults": defaults,
               "folds": folds, "table": table,
               "kinds": {k: {"prior": prior_c[k], "fitted": fit_c[k], "held_out": held_c[k],
                             "prior_offline": prior_o[k], "fitted_offline": fit_o[k],

@@ -5,6 +5,7 @@ same seed gives the same recording."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -243,6 +244,34 @@ def test_sensor_errors_have_the_stated_size():
                                rtol=0.05)
     m_err = (rec.mag - ideal.mag) / s.mag_unit
     np.testing.assert_allclose(m_err.std(0), s.mag_noise, rtol=0.05)
+
+
+def test_gyro_scale_and_cross_axis_errors_multiply_the_true_rate_and_bias():
+    """With ``gyro_scale_sd`` and ``gyro_misalignment_sd`` the gyro reads ``M (ω + b) + n``:
+    the same noise, bias, accelerometer and field as without them (M is drawn last), the
+    difference exactly ``(M − I)(ω + b)``, M's diagonal and off-diagonal of the stated
+    sizes over many seeds; without them M is the identity."""
+    sc = SUITE["spin-coning"]
+    bad = dataclasses.replace(sc, sensors=dataclasses.replace(
+        sc.sensors, gyro_scale_sd=0.01, gyro_misalignment_sd=0.005))
+    dur = sc.rest_s + 2.0  # the rest, then two seconds of spin
+    ideal = S.record(sc, noise=False, duration_s=dur)
+    plain = S.record(sc, 5, duration_s=dur)
+    rec = S.record(bad, 5, duration_s=dur)
+    np.testing.assert_array_equal(plain.gyro_matrix, np.eye(3))
+    for x in ("acc", "mag", "gyro_bias", "q_n_b"):
+        np.testing.assert_array_equal(getattr(rec, x), getattr(plain, x))
+    err = rec.gyro_matrix - np.eye(3)
+    np.testing.assert_allclose(rec.gyro - plain.gyro, (ideal.gyro + plain.gyro_bias) @ err.T,
+                               rtol=0, atol=1e-12)
+    assert np.abs(rec.gyro - plain.gyro).max() > 1e-3  # the spin reads visibly off
+    mats = np.array([S.record(bad, s, duration_s=0.05).gyro_matrix - np.eye(3)
+                     for s in range(200)])
+    off = ~np.eye(3, dtype=bool)
+    assert 0.0085 < mats[:, ~off].std() < 0.0115
+    assert 0.0043 < mats[:, off].std() < 0.0057
+    with pytest.raises(ValueError, match="gyro_scale_sd"):
+        S.Sensors(100.0, gyro_scale_sd=-0.01)
 
 
 def test_record_refuses_a_duration_beyond_the_scenario():

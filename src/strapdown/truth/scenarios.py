@@ -228,6 +228,13 @@ class Sensors:
         Magnetometer noise per sample, µT.
     mag_unit : float
         The recorded field is µT times this (0.01: gauss; any other: arbitrary units).
+    gyro_scale_sd, gyro_misalignment_sd : float
+        Standard deviations of the gyro's relative scale-factor errors (diagonal of
+        ``M − I``) and of its cross-axis sensitivities (off-diagonal), drawn per recording:
+        the measured rate is ``M (ω + b) + n`` (:class:`~strapdown.truth.sensors.GyroErrors`'s
+        order). Default 0 (the suite's recordings); a consumer MEMS gyro's data sheet gives
+        ±1–3 % and ±1–2 % untrimmed (a standard deviation of about 0.01 and 0.005). Drawn
+        after every other error, so a recording with and without them shares its noise.
     acc_sample : {"point", "interval"}
         What an accelerometer sample is: the specific force at the stamp (``point``,
         default: the suite's recordings) or its mean over the sample period that ends at
@@ -245,6 +252,8 @@ class Sensors:
     acc_bias_sd: float = 0.03
     mag_noise: float = 0.3
     mag_unit: float = 1.0
+    gyro_scale_sd: float = 0.0
+    gyro_misalignment_sd: float = 0.0
     acc_sample: Literal["point", "interval"] = "point"
 
     def __post_init__(self):
@@ -254,7 +263,7 @@ class Sensors:
         positive(self.mag_unit, "mag_unit")
         positive(self.gyro_bias_gm_tau, "gyro_bias_gm_tau")
         for name in ("gyro_noise", "gyro_bias_sd", "gyro_bias_gm_sigma", "acc_noise",
-                     "acc_bias_sd", "mag_noise"):
+                     "acc_bias_sd", "mag_noise", "gyro_scale_sd", "gyro_misalignment_sd"):
             if not float(getattr(self, name)) >= 0:
                 raise ValueError(f"{name} must be non-negative, got {getattr(self, name)!r}")
 
@@ -312,6 +321,9 @@ class SimulatedRecording:
         Field in the body, µT × ``scenario.sensors.mag_unit``.
     gyro_bias : ndarray (n, 3)
         The true gyro bias (constant plus slow), rad/s; zero when ``noise=False``.
+    gyro_matrix : ndarray (3, 3)
+        The gyro's scale-factor and cross-axis matrix ``M`` (``Sensors.gyro_scale_sd``,
+        ``gyro_misalignment_sd``); the identity when they are zero or ``noise=False``.
     """
 
     scenario: Scenario
@@ -322,6 +334,7 @@ class SimulatedRecording:
     acc: NDArray[np.float64]
     mag: NDArray[np.float64]
     gyro_bias: NDArray[np.float64]
+    gyro_matrix: NDArray[np.float64] = field(default_factory=lambda: np.eye(3))
 
     @property
     def name(self) -> str:
@@ -347,19 +360,26 @@ def record(scenario: Scenario, seed: RngLike = 0, *, noise: bool = True,
          else interval_integrals(body.specific_force, edges[:-1], t) / np.diff(edges)[:, None])
     m_b = body.field_b(t)
     bias = np.zeros((n, 3))
+    mat = np.eye(3)
     if noise:
         rng = np.random.default_rng(seed)
         b0 = s.gyro_bias_sd * rng.standard_normal(3)
         # the bias alone first (same generator), so that the truth can report it
         slow = GyroErrors(gm_sigma=s.gyro_bias_gm_sigma, gm_tau=s.gyro_bias_gm_tau)
         bias = b0 + slow.apply(np.zeros((n, 3)), "rate", h, rng)
-        w = GyroErrors(white_noise=s.gyro_noise).apply(w + bias, "rate", h, rng)
+        w_b = w + bias
+        w = GyroErrors(white_noise=s.gyro_noise).apply(w_b, "rate", h, rng)
         acc_err = AccelerometerErrors(white_noise=s.acc_noise,
                                       bias=s.acc_bias_sd * rng.standard_normal(3))
         f = accelerometer(t, q, f, h, errors=acc_err, rng=rng)
         c_b_n = np.swapaxes(dcm_from_quat(q), -1, -2)
         m_b = MagnetometerErrors(white_noise=s.mag_noise).apply(t, m_b, c_b_n, rng)
-    return SimulatedRecording(scenario, t, h, q, w, f, m_b * s.mag_unit, bias)
+        if s.gyro_scale_sd > 0 or s.gyro_misalignment_sd > 0:  # M (ω + b) + n, M drawn last
+            err = s.gyro_misalignment_sd * rng.standard_normal((3, 3))
+            np.fill_diagonal(err, s.gyro_scale_sd * rng.standard_normal(3))
+            w = w + w_b @ err.T
+            mat = mat + err
+    return SimulatedRecording(scenario, t, h, q, w, f, m_b * s.mag_unit, bias, mat)
 
 
 # ------------------------------------------------------------------------------ pendulum
