@@ -10,10 +10,10 @@ the simulated scenario kinds of the generalisation suite (``strapdown.truth.scen
 pendulum, vehicle, loiter, spin-coning, hand-held, steel-frame, rests), recorded with the
 sensor errors of ``--seed`` (and, with ``--gyro-scale`` / ``--gyro-misalignment``, a gyro
 scale-factor and cross-axis error of that standard deviation, ``Sensors.gyro_scale_sd``:
-the study on consumer gyros that are not calibrated). Every candidate of :data:`GRID` runs once, causally, on every
-recording. A fold leaves one kind out and picks the candidate best on the other kinds; the
-left-out kind is then scored with it, causally and offline. The defaults are the candidate
-best on every kind.
+the study on consumer gyros that are not calibrated). Every candidate of :data:`GRID` runs
+once, causally, on every recording. A fold leaves one kind out and picks the candidate best
+on the other kinds; the left-out kind is then scored with it, causally and offline. The
+defaults are the candidate best on every kind.
 
 The pendulum, vehicle, spin-coning and hand-held recordings also run without their
 magnetometer, as kinds of a third dataset (6-axis: VQF's 6D estimate the yardstick; the
@@ -195,7 +195,8 @@ def main(argv: list[str] | None = None) -> int:
         c, o = _scores(_DATA, cfg, [k])
         held_c[k], held_o[k] = c[k], o[k]
     report = {"seed": a.seed, "gyro_scale": a.gyro_scale,
-              "gyro_misalignment": a.gyro_misalignment, "grid": GRID, "prior": PRIOR, "defaults": defaults,
+              "gyro_misalignment": a.gyro_misalignment, "grid": GRID, "prior": PRIOR,
+              "defaults": defaults,
               "folds": folds, "table": table,
               "kinds": {k: {"prior": prior_c[k], "fitted": fit_c[k], "held_out": held_c[k],
                             "prior_offline": prior_o[k], "fitted_offline": fit_o[k],

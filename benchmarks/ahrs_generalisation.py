@@ -1,7 +1,8 @@
 """The AHRS generalisation suite over several seeds: our filter and VQF on simulated recordings.
 
 Usage: ``python benchmarks/ahrs_generalisation.py [--seeds 0 1 … 19] [--aligned]
-[--hard-iron F --soft-iron F] [--acc-sample interval] [--out reports/ahrs_generalisation.json]``.
+[--hard-iron F --soft-iron F] [--gyro-scale SD --gyro-misalignment SD] [--acc-sample interval]
+[--out reports/ahrs_generalisation.json]``.
 
 Each seed draws the sensor errors and the random parts of the motions
 (:func:`strapdown.truth.scenarios.suite`, :func:`~strapdown.truth.scenarios.record`); each
@@ -18,6 +19,10 @@ is one seed of it.
 (:func:`uncalibrated`): the recorded field ``m`` becomes ``S m + F_h |m|_med d``, ``d`` a
 random unit vector in the body, ``S = I + F_s U``, ``U`` uniform in (−1, 1) per entry, drawn
 per seed and recording (docs/reproductions.md, "A magnetometer that is not calibrated").
+``--gyro-scale SD --gyro-misalignment SD`` gives every filter an uncalibrated gyro: scale-factor
+and cross-axis errors of these standard deviations drawn per seed and recording
+(``Sensors.gyro_scale_sd``, ``gyro_misalignment_sd``; a consumer MEMS gyro untrimmed: about
+0.01 and 0.005; docs/reproductions.md, "A gyro that is not calibrated").
 ``--acc-sample interval`` records every accelerometer sample as the mean specific force over
 its period, like the gyro's (``Sensors.acc_sample``; the suite's are point samples).
 """
@@ -73,6 +78,10 @@ def main(argv: list[str] | None = None) -> int:
                     help="a hard-iron offset, a fraction of the field's norm (e.g. 0.3)")
     ap.add_argument("--soft-iron", type=float, default=0.0,
                     help="soft-iron scaling: entries of S - I uniform within ± this (e.g. 0.1)")
+    ap.add_argument("--gyro-scale", type=float, default=0.0,
+                    help="the gyro's scale-factor errors, standard deviation (e.g. 0.01)")
+    ap.add_argument("--gyro-misalignment", type=float, default=0.0,
+                    help="its cross-axis sensitivities, standard deviation (e.g. 0.005)")
     ap.add_argument("--acc-sample", choices=["point", "interval"], default="point",
                     help="the simulated accelerometer's samples: at the stamps (the suite's) "
                     "or means over each period, like the gyro's")
@@ -83,7 +92,8 @@ def main(argv: list[str] | None = None) -> int:
     for seed in args.seeds:
         print(f"seed {seed}", file=sys.stderr)
         scenarios = [dataclasses.replace(sc, sensors=dataclasses.replace(
-            sc.sensors, acc_sample=args.acc_sample)) for sc in suite(seed)]
+            sc.sensors, acc_sample=args.acc_sample, gyro_scale_sd=args.gyro_scale,
+            gyro_misalignment_sd=args.gyro_misalignment)) for sc in suite(seed)]
         names = [s.name for s in scenarios]
         alter = None
         if args.hard_iron or args.soft_iron:
@@ -117,6 +127,9 @@ def main(argv: list[str] | None = None) -> int:
     if args.hard_iron or args.soft_iron:
         print(f"magnetometer uncalibrated: hard iron {args.hard_iron:g} of the field's norm, "
               f"soft iron ±{args.soft_iron:g}")
+    if args.gyro_scale or args.gyro_misalignment:
+        print(f"gyro uncalibrated: scale factors ±{args.gyro_scale:g}, cross-axis "
+              f"±{args.gyro_misalignment:g} (standard deviations)")
     if args.out:
         Path(args.out).parent.mkdir(parents=True, exist_ok=True)
         Path(args.out).write_text(json.dumps({"seeds": args.seeds, "scenarios": record},
