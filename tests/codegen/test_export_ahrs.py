@@ -116,6 +116,9 @@ OPTIONS = [
     ("rate-single", {"acc_motion_leak": 0.5, "acc_sample": "point"}, True),
     ("rate-single", {"acc_motion_leak": 0.3, "estimate_acc_bias": True, "mag_sample": "interval"},
      True),
+    # the bias floor of an uncalibrated gyro on a sustained rotation (a short average, so
+    # that the floor binds within the record)
+    ("rate-single", {"gyro_scale_sigma": 0.02, "gyro_scale_tau": 0.5}, True),
 ]
 
 

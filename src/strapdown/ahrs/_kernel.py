@@ -11,7 +11,9 @@ a small function that numba inlines into the loop (``inline="always"``):
    sliding scheme's first outputs) or :func:`_rk4_step` (quaternion RK4);
 2. :func:`_fold_rest_samples` — the rest detector's moving averages;
 3. :func:`_propagate_covariance` and :func:`_add_process_noise` — ``P ← Φ P Φᵀ + Q``,
-   with a tilt noise proportional to the rotation rate;
+   with a tilt noise proportional to the rotation rate; :func:`_scale_floor` (with
+   ``gyro_scale_sigma``) — the bias's variance kept above an uncalibrated gyro's scale
+   error on the averaged rate;
 4. :func:`_rest_detect`, :func:`_rest_still` and :func:`_rest_model` — the zero-rate bias
    update, once rest has lasted ``rest_min_s``;
 5. the accelerometer: recovery (:func:`_acc_recovery`), then the model of
@@ -151,6 +153,8 @@ class Params(NamedTuple):
     gyro_bias_rw: float
     tilt_rate_noise: float
     heading_rate_noise: float
+    gyro_scale_sigma: float
+    gyro_scale_tau: float
     singer_sigma: float
     singer_tau: float
     acc_noise: float
@@ -744,6 +748,21 @@ def _add_process_noise(P, C, phi, T, qg, qb, qa, qab, params, singer, unobserved
             P[6 + r, 6 + r] += qa
         if nx > (9 if singer else 6):
             P[nx - 3 + r, nx - 3 + r] += qab
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _scale_floor(P, phi, T, sigma, tau, w_slow):
+    """Stage 3, with ``gyro_scale_sigma`` (``sigma``): the gyro's scale error on a
+    sustained rotation is a slowly varying bias ``s ω̄``; the bias's variance is raised to
+    at least ``(σ_s ω̄_a)²`` per axis, ``ω̄`` (``w_slow``, updated here) the epoch's
+    bias-corrected rate ``φ/T`` averaged with time constant ``tau`` (``gyro_scale_tau``).
+    Raising a diagonal element keeps P positive semi-definite."""
+    k = 1.0 - np.exp(-T / tau)
+    for a in range(3):
+        w_slow[a] += k * (phi[a] / T - w_slow[a])
+        f = (sigma * w_slow[a]) ** 2
+        if P[3 + a, 3 + a] < f:
+            P[3 + a, 3 + a] = f
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -1415,6 +1434,7 @@ def ekf_kernel(sensors, prop, window, params, init, out):
     # propagation work: rotation vector of the epoch (per epoch, for the covariance),
     # quaternion, nodes of the windowed form, bias in the units of x, RK4 rates and stages
     phi = np.empty(3)
+    w_slow = np.zeros(3)
     tmp = np.empty(4)
     base = np.empty(4)
     nodes = np.empty((max(offsets.size, 1), 3))
@@ -1551,6 +1571,8 @@ def ekf_kernel(sensors, prop, window, params, init, out):
         _propagate_covariance(P, phi, T, decay, singer, A, M)
         _add_process_noise(P, C, phi, T, qg, qb, qa, qab, params, singer, heading_unobserved,
                            mag_dist_prev)
+        if params.gyro_scale_sigma > 0.0:
+            _scale_floor(P, phi, T, params.gyro_scale_sigma, params.gyro_scale_tau, w_slow)
         flags = 0
         dx[:] = 0.0
         tk = k * h
