@@ -93,6 +93,12 @@ def _arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--declination-deg", type=float, default=0.0,
                    help="magnetic declination (deg, east positive, within ±180); 0 gives a "
                    "magnetic-north heading")
+    p.add_argument("--gyro-scale-sigma", type=float, default=0.0, metavar="SD",
+                   help="for an uncalibrated gyro on a body that keeps turning one way (a "
+                   "spinning projectile, a circling vehicle): the standard deviation of its "
+                   "relative scale-factor error, e.g. 0.01; the gyro bias then follows the "
+                   "scale error of the sustained rotation (AhrsConfig.gyro_scale_sigma). "
+                   "Default 0: off, right for a calibrated gyro")
     progress_args(p, "a line as the filter starts and ends")
 
 
@@ -106,9 +112,12 @@ def run(args: argparse.Namespace) -> int:
     if not abs(args.declination_deg) <= MAX_DECLINATION_DEG:
         raise InputError(f"--declination-deg must lie within ±{MAX_DECLINATION_DEG:g}° (east "
                          f"positive), got {args.declination_deg:g}")
+    if not (0.0 <= args.gyro_scale_sigma < 1.0):
+        raise InputError(f"--gyro-scale-sigma is a relative scale-factor error's standard "
+                         f"deviation, within [0, 1) (e.g. 0.01), got {args.gyro_scale_sigma:g}")
     cfg = AhrsConfig(gating=not args.no_gating, declination_deg=args.declination_deg,
                      gyro_sample=args.gyro_sample, acc_sample=args.acc_sample,
-                     mag_sample=args.mag_sample)
+                     mag_sample=args.mag_sample, gyro_scale_sigma=args.gyro_scale_sigma)
     show = progress(args)
     if show:
         say(f"filtering {args.imu} ({args.algorithm}"
