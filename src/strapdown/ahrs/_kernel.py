@@ -154,7 +154,6 @@ class Params(NamedTuple):
     tilt_rate_noise: float
     heading_rate_noise: float
     gyro_scale_sigma: float
-    gyro_scale_tau: float
     singer_sigma: float
     singer_tau: float
     acc_noise: float
@@ -210,6 +209,7 @@ class Params(NamedTuple):
     lp_settle: int  #: the low-pass model updates from epoch lp_init_n + lp_settle (0 or −lp_init_n)
     dyn_k: float  #: gain per epoch of the motion acceleration's moving mean square
     dyn_k2: float  #: gain per epoch of the slow mean of the low-passed specific force
+    scale_k: float  #: gain per epoch of the averaged rate of gyro_scale_sigma (gyro_scale_tau)
     mc_b0: float  #: the low-pass of the field's norm and dip, likewise
     mc_b1: float
     mc_b2: float
@@ -751,13 +751,13 @@ def _add_process_noise(P, C, phi, T, qg, qb, qa, qab, params, singer, unobserved
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _scale_floor(P, phi, T, sigma, tau, w_slow):
+def _scale_floor(P, phi, T, sigma, k, w_slow):
     """Stage 3, with ``gyro_scale_sigma`` (``sigma``): the gyro's scale error on a
     sustained rotation is a slowly varying bias ``s ω̄``; the bias's variance is raised to
     at least ``(σ_s ω̄_a)²`` per axis, ``ω̄`` (``w_slow``, updated here) the epoch's
-    bias-corrected rate ``φ/T`` averaged with time constant ``tau`` (``gyro_scale_tau``).
-    Raising a diagonal element keeps P positive semi-definite."""
-    k = 1.0 - np.exp(-T / tau)
+    bias-corrected rate ``φ/T`` averaged with gain ``k`` per epoch (``Params.scale_k``:
+    time constant ``gyro_scale_tau``). Raising a diagonal element keeps P positive
+    semi-definite."""
     for a in range(3):
         w_slow[a] += k * (phi[a] / T - w_slow[a])
         f = (sigma * w_slow[a]) ** 2
@@ -1572,7 +1572,7 @@ def ekf_kernel(sensors, prop, window, params, init, out):
         _add_process_noise(P, C, phi, T, qg, qb, qa, qab, params, singer, heading_unobserved,
                            mag_dist_prev)
         if params.gyro_scale_sigma > 0.0:
-            _scale_floor(P, phi, T, params.gyro_scale_sigma, params.gyro_scale_tau, w_slow)
+            _scale_floor(P, phi, T, params.gyro_scale_sigma, params.scale_k, w_slow)
         flags = 0
         dx[:] = 0.0
         tk = k * h
