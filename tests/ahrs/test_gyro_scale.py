@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import dataclasses
 import warnings
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -40,17 +41,24 @@ def _total(result, rec) -> float:
 
 @pytest.fixture(scope="module")
 def spin():
+    """The spinning body with the 1 % error: the recording, the causal filter without and
+    with the floor, the offline filter, and the offline filter without the rerun's rule
+    (no heading rate noise to fall back on)."""
     rec = _recording("spin-coning")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        return rec, ekf(rec.t, rec.gyro, rec.acc, rec.mag), ekf(rec.t, rec.gyro, rec.acc,
-                                                                  rec.mag, config=ON)
+        return SimpleNamespace(
+            rec=rec, causal=ekf(rec.t, rec.gyro, rec.acc, rec.mag),
+            causal_on=ekf(rec.t, rec.gyro, rec.acc, rec.mag, config=ON),
+            offline=offline_ekf(rec.t, rec.gyro, rec.acc, rec.mag),
+            no_rule=offline_ekf(rec.t, rec.gyro, rec.acc, rec.mag,
+                                config=AhrsConfig(heading_rate_noise=0.0)))
 
 
 def test_the_bias_follows_the_scale_error_of_the_spin_and_holds_the_heading(spin):
     """Without the floor the heading lags the drift by 15°; with it the bias learns the
     spin's scale error (2.4°, most of it while the averaged rate builds up)."""
-    rec, off, on = spin
+    rec, off, on = spin.rec, spin.causal, spin.causal_on
     assert _total(off, rec) > 12.0
     assert _total(on, rec) < 3.0
 
@@ -58,7 +66,7 @@ def test_the_bias_follows_the_scale_error_of_the_spin_and_holds_the_heading(spin
 def test_the_learned_bias_is_the_scale_error_times_the_spin(spin):
     """Over the last ten seconds the x bias (the spin axis) is the true bias plus the
     first row of M − I times the mean rate, within 10 % of that scale part."""
-    rec, _, on = spin
+    rec, on = spin.rec, spin.causal_on
     last = rec.t > rec.t[-1] - 10.0
     w = rec.gyro[last].mean(axis=0)  # ≈ M ω: the scale part is (M − I) ω to first order
     expected = rec.gyro_bias[last, 0].mean() + (rec.gyro_matrix[0] - np.eye(3)[0]) @ w
@@ -89,40 +97,30 @@ def test_options_are_checked():
     with pytest.raises(ValueError, match="gyro_scale_tau"):
         AhrsConfig(gyro_scale_tau=0.0)
 
+
 # --- offline_ekf's rerun when the heading escaped its covariance
 
 
-@pytest.fixture(scope="module")
-def uncalibrated():
-    rec = _recording("spin-coning")
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        return (rec, ekf(rec.t, rec.gyro, rec.acc, rec.mag),
-                offline_ekf(rec.t, rec.gyro, rec.acc, rec.mag),
-                offline_ekf(rec.t, rec.gyro, rec.acc, rec.mag,
-                            config=AhrsConfig(heading_rate_noise=0.0)))
-
-
-def test_the_drawn_scale_error_drifts_the_heading_by_degrees_per_second(uncalibrated):
-    rec = uncalibrated[0]
+def test_the_drawn_scale_error_drifts_the_heading_by_degrees_per_second(spin):
+    rec = spin.rec
     spin = np.abs(rec.gyro[rec.t > 5.0, 0]).mean()
     drift = np.degrees(abs(rec.gyro_matrix[0, 0] - 1.0) * spin)
     assert 6.0 < drift < 9.0
 
 
-def test_offline_passes_rerun_with_the_rate_noise_and_beat_the_causal_filter(uncalibrated):
+def test_offline_passes_rerun_with_the_rate_noise_and_beat_the_causal_filter(spin):
     """With the rule, offline is better than causal (5–8° against 10–15° over seeds);
     its result's config says the passes used the causal heading rate noise."""
-    rec, causal, offline, _ = uncalibrated
+    rec, causal, offline = spin.rec, spin.causal, spin.offline
     assert offline.config.offline_heading_rate_noise == AhrsConfig().heading_rate_noise
     assert _total(offline, rec) < 0.8 * _total(causal, rec)
     assert _total(offline, rec) < 12.0
 
 
-def test_without_the_rule_the_offline_heading_runs_away(uncalibrated):
+def test_without_the_rule_the_offline_heading_runs_away(spin):
     """The failure the rule exists for: with no heading rate noise to fall back on (the rule
     then does not apply), the offline passes lose the field and their heading runs away."""
-    rec, _, _, no_rule = uncalibrated
+    rec, no_rule = spin.rec, spin.no_rule
     assert no_rule.config.offline_heading_rate_noise == 0.0
     assert _total(no_rule, rec) > 45.0
 

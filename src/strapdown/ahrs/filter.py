@@ -1445,13 +1445,9 @@ def _clean_field_rejected(flags: np.ndarray) -> float:
     false-alarm probability — ``P(χ²₁ > mag_gate)``, 4.6 % at the default 4 — and a
     quarter of them (:data:`HEADING_ESCAPED_SHARE`, over five times that) says the
     heading has left its covariance for good: the gyro drifts in heading faster than its
-    model allows and the field, rejected, no longer pulls it back. Without heading rate
-    noise (``offline_heading_rate_noise``, 0) that happens to an uncalibrated gyro on a
-    sustained spin: a 1 % scale-factor error on the simulated spin-coning body (540 °/s)
-    turns the heading by up to 8 °/s; the offline passes ran away to 81–118° while the
-    causal filter, with its rate noise, stayed at 10–15° (docs/reproductions.md, "A gyro
-    that is not calibrated"). Measured shares without such an error: BROAD's fifteen
-    trials 0–1.2 %, the suite's scenarios 0–6.5 %; with it, the runaways 64–74 %.
+    model allows and the field, rejected, no longer pulls it back (the case and its
+    figures: ``AhrsConfig.offline_heading_rate_noise``). Measured shares: BROAD's fifteen
+    trials 0–1.2 %, the suite's scenarios 0–6.5 %; the runaways 64–74 %.
     """
     clean = (flags & int(MeasurementFlag.MAG_DISTURBED)) == 0
     seen = clean & ((flags & int(MeasurementFlag.MAG_USED | MeasurementFlag.MAG_REJECTED)) > 0)
