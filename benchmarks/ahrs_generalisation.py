@@ -2,7 +2,7 @@
 
 Usage: ``python benchmarks/ahrs_generalisation.py [--seeds 0 1 … 19] [--aligned]
 [--hard-iron F --soft-iron F] [--gyro-scale SD --gyro-misalignment SD] [--acc-sample interval]
-[--out reports/ahrs_generalisation.json]``.
+[--set FIELD=VALUE ...] [--out reports/ahrs_generalisation.json]``.
 
 Each seed draws the sensor errors and the random parts of the motions
 (:func:`strapdown.truth.scenarios.suite`, :func:`~strapdown.truth.scenarios.record`); each
@@ -23,6 +23,8 @@ per seed and recording (docs/reproductions.md, "A magnetometer that is not calib
 and cross-axis errors of these standard deviations drawn per seed and recording
 (``Sensors.gyro_scale_sd``, ``gyro_misalignment_sd``; a consumer MEMS gyro untrimmed: about
 0.01 and 0.005; docs/reproductions.md, "A gyro that is not calibrated").
+``--set FIELD=VALUE`` (repeatable) changes our filters' options (an ``AhrsConfig`` field,
+typed by it; e.g. ``--set gyro_scale_sigma=0.01``); VQF's stay its defaults.
 ``--acc-sample interval`` records every accelerometer sample as the mean specific force over
 its period, like the gyro's (``Sensors.acc_sample``; the suite's are point samples).
 """
@@ -38,7 +40,9 @@ from pathlib import Path
 
 import numpy as np
 
+from strapdown.ahrs import AhrsConfig
 from strapdown.apps.ahrs_generalisation import FILTERS, evaluate
+from strapdown.cli._common import ahrs_config_fields
 from strapdown.truth.scenarios import SimulatedRecording, suite
 
 _PAIRS = (("strapdown EKF", "VQF"), ("strapdown EKF offline", "offlineVQF"))
@@ -85,8 +89,14 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--acc-sample", choices=["point", "interval"], default="point",
                     help="the simulated accelerometer's samples: at the stamps (the suite's) "
                     "or means over each period, like the gyro's")
+    ap.add_argument("--set", dest="config", action="append", default=[],
+                    metavar="FIELD=VALUE", help="an AhrsConfig field of our filters (repeatable)")
     ap.add_argument("--out", default=None, help="write every figure as JSON here")
     args = ap.parse_args(argv)
+    try:
+        config = AhrsConfig(**ahrs_config_fields(args.config))
+    except ValueError as exc:
+        ap.error(str(exc))
     per_seed = {}
     names: list[str] = []
     for seed in args.seeds:
@@ -100,7 +110,8 @@ def main(argv: list[str] | None = None) -> int:
             def alter(rec, k, seed=seed):
                 rng = np.random.default_rng(1000 + 17 * seed + k)
                 return uncalibrated(rec, args.hard_iron, args.soft_iron, rng)
-        per_seed[seed] = evaluate(scenarios, seed=seed, aligned=args.aligned, alter=alter)
+        per_seed[seed] = evaluate(scenarios, seed=seed, aligned=args.aligned, alter=alter,
+                                  config=config)
     header = ["scenario", *FILTERS, "ours/VQF causal", "ours/VQF offline"]
     print("| " + " | ".join(header) + " |\n|" + "---|" * len(header))
     record = []
@@ -130,6 +141,8 @@ def main(argv: list[str] | None = None) -> int:
     if args.gyro_scale or args.gyro_misalignment:
         print(f"gyro uncalibrated: scale factors ±{args.gyro_scale:g}, cross-axis "
               f"±{args.gyro_misalignment:g} (standard deviations)")
+    if args.config:
+        print("our filters with " + ", ".join(args.config))
     if args.out:
         Path(args.out).parent.mkdir(parents=True, exist_ok=True)
         Path(args.out).write_text(json.dumps({"seeds": args.seeds, "scenarios": record},

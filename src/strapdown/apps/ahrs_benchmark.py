@@ -36,6 +36,7 @@ import math
 import os
 import time
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 from typing import Any, Literal, get_args
 
@@ -123,14 +124,17 @@ def _fusion(tr: BroadTrial) -> NDArray[np.float64]:
     return q
 
 
-def run_filter(name: FilterName, tr: BroadTrial, *, algorithm: str = "rate-single"
-               ) -> NDArray[np.float64]:
-    """One filter on one trial: q_ENU_b at every sample, shape (n, 4)."""
+def run_filter(name: FilterName, tr: BroadTrial, *, algorithm: str = "rate-single",
+               config: AhrsConfig | None = None) -> NDArray[np.float64]:
+    """One filter on one trial: q_ENU_b at every sample, shape (n, 4). ``config``: our
+    filters' options (default :class:`AhrsConfig`), under each variant's own changes."""
+    base = config or AhrsConfig()
     if name in _OURS:
         return ekf(tr.t, tr.gyro, tr.acc, tr.mag, algorithm=algorithm,
-                   config=AhrsConfig(**_OURS[name])).q
+                   config=replace(base, **_OURS[name])).q
     if name == "strapdown EKF offline":
-        return offline_ekf(tr.t, tr.gyro, tr.acc, tr.mag, algorithm=algorithm).q
+        return offline_ekf(tr.t, tr.gyro, tr.acc, tr.mag, algorithm=algorithm,
+                           config=base).q
     peers: dict[str, Callable[[BroadTrial], NDArray[np.float64]]] = {
         "VQF": _vqf, "offlineVQF": _offline_vqf, "Fusion": _fusion}
     if name not in peers:

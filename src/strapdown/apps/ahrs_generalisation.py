@@ -23,6 +23,7 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
+from strapdown.ahrs import AhrsConfig
 from strapdown.analysis.alignment import aligned_errors
 from strapdown.analysis.broad import broad_errors
 from strapdown.apps.ahrs_benchmark import KIND, FilterName, _available, run_filter
@@ -54,8 +55,8 @@ def trial(rec: SimulatedRecording, settle_s: float = SETTLE_S) -> BroadTrial:
 def evaluate(scenarios: Sequence[Scenario] | None = None, *, seed: int = 0,
              duration_s: float | None = None, filters: Sequence[FilterName] = FILTERS,
              progress: Callable[[str], None] | None = None, aligned: bool = False,
-             alter: Callable[[SimulatedRecording, int], SimulatedRecording] | None = None
-             ) -> dict:
+             alter: Callable[[SimulatedRecording, int], SimulatedRecording] | None = None,
+             config: AhrsConfig | None = None) -> dict:
     """Each filter on each scenario: ``{(scenario, filter): broad_errors(...)}``.
 
     ``duration_s`` shortens every recording (e.g. :data:`SHORT_S`); a filter whose package
@@ -64,7 +65,8 @@ def evaluate(scenarios: Sequence[Scenario] | None = None, *, seed: int = 0,
     (:func:`strapdown.analysis.alignment.aligned_errors`, the metric of the issue's
     held-back recordings), which forgives a constant offset but not a drift. ``alter(rec,
     k)`` replaces each recording (``k`` its index in the suite) before the filters run: a
-    sensor error the suite does not model, such as an uncalibrated magnetometer."""
+    sensor error the suite does not model, such as an uncalibrated magnetometer.
+    ``config``: our filters' options (default :class:`~strapdown.ahrs.AhrsConfig`)."""
     scenarios = suite(seed) if scenarios is None else scenarios
     say = progress or (lambda _m: None)
     ran = [f for f in filters if _available(f) is None]
@@ -77,7 +79,7 @@ def evaluate(scenarios: Sequence[Scenario] | None = None, *, seed: int = 0,
         tr = trial(rec)
         for f in ran:
             say(f"{sc.name}: {f}")
-            q = run_filter(f, tr)
+            q = run_filter(f, tr, config=config)
             out[(sc.name, f)] = (aligned_errors if aligned else broad_errors)(
                 q, rec.q_n_b, tr.movement)
     return out
