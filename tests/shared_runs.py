@@ -44,6 +44,8 @@ def recording() -> Iterator[None]:
         bound.apply_defaults()
         res = real(*args, **kwargs)
         a = bound.arguments
+        if a["config"] is not None:  # not the defaults a test takes the results for
+            return res
         key = (str(Path(a["directory"]).resolve()), a["algorithm"],
                bool(a["heading_offset_removed"]))
         _BROAD[key] = (copy.deepcopy(res), Path(a["out"]).resolve())

@@ -97,3 +97,39 @@ def test_config_reaches_our_filters_causal_and_offline():
     six = evaluate(sc, config=AhrsConfig(use_magnetometer=False), **run)
     for f in run["filters"]:
         assert six[("rests", f)]["total_deg"] != base[("rests", f)]["total_deg"]
+
+
+def test_set_reaches_our_filters_only_and_is_named(tmp_path, capsys, monkeypatch):
+    """``--set FIELD=VALUE``: every run of our filters gets the changed AhrsConfig (the peers
+    get none), and the output and the report name the change."""
+    import numpy as np
+
+    import strapdown.apps.ahrs_generalisation as gen
+
+    seen = []
+
+    def fake(name, tr, *, config=None):
+        seen.append((name, config))
+        return np.tile([1.0, 0.0, 0.0, 0.0], (tr.t.size, 1))
+
+    monkeypatch.setattr(gen, "run_filter", fake)
+    monkeypatch.setattr(gen, "_available", lambda _f: None)
+    main(["benchmark-ahrs", "--suite", "generalisation", "--short", "--out", str(tmp_path),
+          "--no-progress", "--set", "heading_noise=0.05", "--set", "gating=false"])
+    ours = [c for f, c in seen if f.startswith("strapdown")]
+    assert len(ours) == 2 * len(suite(0)) and len(seen) == len(FILTERS) * len(suite(0))
+    assert all(c.heading_noise == 0.05 and c.gating is False for c in ours)
+    note = "their defaults but heading_noise=0.05, gating=False"
+    assert note in capsys.readouterr().out
+    assert note in (tmp_path / "report.md").read_text(encoding="utf-8")
+
+
+@pytest.mark.parametrize("item, said", [("heading_nois=0.05", "AhrsConfig field"),
+                                        ("gating=maybe", "expected true or false")])
+def test_a_bad_set_is_refused_before_anything_runs(tmp_path, capsys, item, said):
+    with pytest.raises(SystemExit) as exc:
+        main(["benchmark-ahrs", "--suite", "generalisation", "--out", str(tmp_path / "r"),
+              "--no-progress", "--set", item])
+    assert exc.value.code == 2
+    assert said in capsys.readouterr().err
+    assert not (tmp_path / "r").exists()

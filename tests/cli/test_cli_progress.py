@@ -33,7 +33,8 @@ def fake_benchmark(monkeypatch):
 
     given = []
 
-    def benchmark(directory, out, *, algorithm, heading_offset_removed, progress=None):
+    def benchmark(directory, out, *, algorithm, heading_offset_removed, config=None,
+                  progress=None):
         given.append(progress)
         if progress is not None:
             progress("01_trial: strapdown-ekf")

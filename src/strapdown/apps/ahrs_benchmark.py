@@ -36,7 +36,7 @@ import math
 import os
 import time
 from collections.abc import Callable
-from dataclasses import replace
+from dataclasses import fields, replace
 from pathlib import Path
 from typing import Any, Literal, get_args
 
@@ -48,7 +48,8 @@ from strapdown.analysis.broad import broad_errors
 from strapdown.io.broad import BroadTrial, read_broad
 from strapdown.io.report import Report
 
-__all__ = ["ABLATIONS", "COMPARED", "FILTERS", "KIND", "FilterName", "benchmark", "mean_of",
+__all__ = ["ABLATIONS", "COMPARED", "FILTERS", "KIND", "FilterName", "benchmark", "config_note",
+           "mean_of",
            "mean_total", "run_filter"]
 
 #: The filters (see the module docstring): the compared ones first, then the ablations.
@@ -142,6 +143,17 @@ def run_filter(name: FilterName, tr: BroadTrial, *, algorithm: str = "rate-singl
     return peers[name](tr)
 
 
+def config_note(config: AhrsConfig | None) -> str:
+    """How a report names our filters' options: ``"their defaults"``, or the fields of
+    ``config`` that differ from :class:`AhrsConfig`'s defaults, ``"field=value"`` each."""
+    if config is None:
+        return "their defaults"
+    base = AhrsConfig()
+    changed = [f"{f.name}={getattr(config, f.name)!r}" for f in fields(AhrsConfig)
+               if getattr(config, f.name) != getattr(base, f.name)]
+    return "their defaults" if not changed else "their defaults but " + ", ".join(changed)
+
+
 def _available(name: str) -> str | None:
     """None if the filter can run, else why not."""
     mod = _PEER_MODULE.get(name)
@@ -161,7 +173,7 @@ def _warm_up(tr: BroadTrial, algorithm: str) -> None:
 
 
 def _run_all(files: list[Path], ran: list[FilterName], rep: Report, algorithm: str,
-             heading_offset_removed: bool) -> tuple[dict, dict]:
+             heading_offset_removed: bool, config: AhrsConfig | None) -> tuple[dict, dict]:
     """Every filter on every trial: ``({(trial, filter): errors}, {filter: [samples, s]})``."""
     results: dict = {}
     timing = {f: [0, 0.0] for f in ran}
@@ -172,7 +184,7 @@ def _run_all(files: list[Path], ran: list[FilterName], rep: Report, algorithm: s
         for f in ran:
             rep.say(f"{tr.name}: {f}")
             tic = time.perf_counter()
-            q = run_filter(f, tr, algorithm=algorithm)
+            q = run_filter(f, tr, algorithm=algorithm, config=config)
             timing[f][1] += time.perf_counter() - tic
             timing[f][0] += tr.t.size
             if q.shape != (tr.t.size, 4):
@@ -290,10 +302,12 @@ def _chart(rep: Report, names: list[str], ran: list[FilterName], results: dict) 
 
 def benchmark(directory: str | os.PathLike[str], out: str | os.PathLike[str], *,
               algorithm: str = "rate-single", heading_offset_removed: bool = False,
+              config: AhrsConfig | None = None,
               progress: Callable[[str], None] | None = None) -> dict:
     """Run every filter on every trial; returns ``{(trial, filter): errors}`` (the keys of
     :func:`strapdown.analysis.broad.broad_errors`, plus ``samples_per_s``) and writes the
-    report to ``out``."""
+    report to ``out``. ``config``: our filters' options (default :class:`AhrsConfig`; the
+    ablations change theirs on top of it), named in the report (:func:`config_note`)."""
     from strapdown.io.broad import broad_hint
 
     if not str(directory):  # "$STRAPDOWN_BROAD" with the variable unset
@@ -307,7 +321,8 @@ def benchmark(directory: str | os.PathLike[str], out: str | os.PathLike[str], *,
     rep = Report.begin(out, progress)
     missing = {f: why for f in FILTERS if (why := _available(f))}
     ran = [f for f in FILTERS if f not in missing]
-    results, timing = _run_all(files, ran, rep, algorithm, heading_offset_removed)
+    results, timing = _run_all(files, ran, rep, algorithm, heading_offset_removed,
+                               config)
     names = [p.stem for p in files]
     md = ["# AHRS on BROAD: strapdown's EKF against VQF and Fusion\n\n",
           "Data: BROAD (Laidig, Caruso, Cereatti & Seel, Data 6(7), 2021; CC BY 4.0), "
@@ -316,7 +331,8 @@ def benchmark(directory: str | os.PathLike[str], out: str | os.PathLike[str], *,
           "sample, no heading offset removed (the optical reference is in the magnetic ENU "
           "frame); total, heading (rotation about the vertical) and inclination (the rest), "
           "degrees. Causal: the estimate at a sample uses no later sample (real time); "
-          f"acausal: post-processing. Our propagation: {algorithm}; VQF with its defaults.\n\n"]
+          f"acausal: post-processing. Our propagation: {algorithm}; our filters with "
+          f"{config_note(config)}; VQF with its defaults.\n\n"]
     if missing:
         md.append("Not run: " + "; ".join(f"{k} — {v}" for k, v in missing.items()) + "\n\n")
     md.append("## Mean over the trials\n\n" + _summary(rep, names, ran, results, timing))

@@ -26,7 +26,7 @@ import numpy as np
 from strapdown.ahrs import AhrsConfig
 from strapdown.analysis.alignment import aligned_errors
 from strapdown.analysis.broad import broad_errors
-from strapdown.apps.ahrs_benchmark import KIND, FilterName, _available, run_filter
+from strapdown.apps.ahrs_benchmark import KIND, FilterName, _available, config_note, run_filter
 from strapdown.io.broad import BroadTrial
 from strapdown.io.report import Report
 from strapdown.truth.scenarios import Scenario, SimulatedRecording, record, suite
@@ -126,14 +126,16 @@ def summary_table(results: dict, names: Sequence[str]) -> str:
 
 
 def generalisation(out: str | os.PathLike[str], *, seed: int = 0, short: bool = False,
+                   config: AhrsConfig | None = None,
                    progress: Callable[[str], None] | None = None) -> dict:
     """Run :func:`evaluate` on the suite and write ``report.md`` and the tables
     (``generalisation.csv``/``.md``: per scenario; ``errors.csv``/``.md``: long form) to
-    ``out``; returns the results."""
+    ``out``; returns the results. ``config``: our filters' options (default
+    :class:`~strapdown.ahrs.AhrsConfig`), named in the report."""
     rep = Report.begin(out, progress)
     scenarios = suite(seed)
     results = evaluate(scenarios, seed=seed, duration_s=SHORT_S if short else None,
-                       progress=rep.say)
+                       config=config, progress=rep.say)
     names = [s.name for s in scenarios]
     header, body = rows(results, names)
     table = rep.table("generalisation", header, body)
@@ -147,7 +149,8 @@ def generalisation(out: str | os.PathLike[str], *, seed: int = 0, short: bool = 
           f"Seed {seed}{', short versions (' + str(SHORT_S) + ' s)' if short else ''}. "
           "Metric: BROAD's (total / inclination RMSE, degrees, no alignment: the truth is "
           f"in the estimates' magnetic ENU frame) from {SETTLE_S:g} s on. Ratio: ours over "
-          "the VQF of the same kind, total RMSE (mean row: geometric mean).\n\n"]
+          "the VQF of the same kind, total RMSE (mean row: geometric mean). Our filters with "
+          f"{config_note(config)}; VQF with its defaults.\n\n"]
     if missing:
         md.append("Not run: " + ", ".join(f"{f} ({_available(f)})" for f in missing) + "\n\n")
     md.append("## Scenarios\n\n" + "".join(f"- `{s.name}` — {s.describe()}\n"

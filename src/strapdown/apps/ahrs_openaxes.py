@@ -37,9 +37,9 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from strapdown.ahrs import AccelerometerUnusedWarning, ekf, offline_ekf
+from strapdown.ahrs import AccelerometerUnusedWarning, AhrsConfig, ekf, offline_ekf
 from strapdown.analysis.alignment import aligned_errors
-from strapdown.apps.ahrs_benchmark import KIND, FilterName, _available, vqf_attitude
+from strapdown.apps.ahrs_benchmark import KIND, FilterName, _available, config_note, vqf_attitude
 from strapdown.io.openaxes import (
     SUSPECT,
     OpenAxesRecording,
@@ -62,12 +62,14 @@ RATE_AGREEMENT_MIN = 0.9
 _PAIRS = (("strapdown EKF", "VQF"), ("strapdown EKF offline", "offlineVQF"))
 
 
-def run_filter(name: FilterName, rec: OpenAxesRecording) -> NDArray[np.float64]:
-    """One filter on one recording, 6-axis: its attitude at every sample, (n, 4)."""
+def run_filter(name: FilterName, rec: OpenAxesRecording, *,
+               config: AhrsConfig | None = None) -> NDArray[np.float64]:
+    """One filter on one recording, 6-axis: its attitude at every sample, (n, 4). ``config``:
+    our filters' options (default :class:`~strapdown.ahrs.AhrsConfig`)."""
     if name == "strapdown EKF":
-        return ekf(rec.t, rec.gyro, rec.acc).q
+        return ekf(rec.t, rec.gyro, rec.acc, config=config).q
     if name == "strapdown EKF offline":
-        return offline_ekf(rec.t, rec.gyro, rec.acc).q
+        return offline_ekf(rec.t, rec.gyro, rec.acc, config=config).q
     if name in ("VQF", "offlineVQF"):
         return vqf_attitude(rec.gyro, rec.acc, None, rec.h, offline=name == "offlineVQF")
     raise ValueError(f"unknown filter {name!r}; choose one of {', '.join(FILTERS)}")
@@ -86,8 +88,10 @@ def suspect_reason(rec: OpenAxesRecording) -> str | None:
 
 def evaluate(directory: str | os.PathLike[str], *, names: Sequence[str] | None = None,
              filters: Sequence[FilterName] = FILTERS, settle_s: float = SETTLE_S,
+             config: AhrsConfig | None = None,
              progress: Callable[[str], None] | None = None) -> tuple[dict, dict]:
-    """Each filter on each recording of ``directory`` (or those of ``names``).
+    """Each filter on each recording of ``directory`` (or those of ``names``); ``config``:
+    our filters' options (default :class:`~strapdown.ahrs.AhrsConfig`).
 
     Returns ``(results, suspects)``: ``{(recording, filter): aligned_errors(...)}``, each
     with ``"accelerometer_unused"``: whether the filter warned
@@ -114,7 +118,7 @@ def evaluate(directory: str | os.PathLike[str], *, names: Sequence[str] | None =
             say(f"{rec.name}: {f}")
             with warnings.catch_warnings(record=True) as caught:
                 warnings.simplefilter("always", AccelerometerUnusedWarning)
-                q = run_filter(f, rec)
+                q = run_filter(f, rec, config=config)
             e = aligned_errors(q, rec.q_ref, mask)
             e["accelerometer_unused"] = any(
                 issubclass(w.category, AccelerometerUnusedWarning) for w in caught)
@@ -193,13 +197,13 @@ def summary_table(results: dict, suspects: dict) -> str:
 
 
 def openaxes(directory: str | os.PathLike[str], out: str | os.PathLike[str], *,
-             names: Sequence[str] | None = None,
+             names: Sequence[str] | None = None, config: AhrsConfig | None = None,
              progress: Callable[[str], None] | None = None) -> tuple[dict, dict]:
     """Run :func:`evaluate` and write ``report.md`` and the tables (``openaxes.csv``/``.md``:
     per recording; ``errors.csv``/``.md``: every filter, total / heading / inclination, the
     fit's Newton steps) to ``out``; returns what :func:`evaluate` returns."""
     rep = Report.begin(out, progress)
-    results, suspects = evaluate(directory, names=names, progress=rep.say)
+    results, suspects = evaluate(directory, names=names, config=config, progress=rep.say)
     header, body = rows(results, suspects)
     table = rep.table("openaxes", header, body)
     long = rep.table("errors", ["recording", "filter", "kind", "total (°)", "heading (°)",
@@ -215,7 +219,8 @@ def openaxes(directory: str | os.PathLike[str], out: str | os.PathLike[str], *,
           "and a constant body rotation fitted to each estimate (least squares, the same for "
           "every filter), then "
           f"total / inclination RMSE (degrees) from {SETTLE_S:g} s on. Ratios: ours over the "
-          "VQF of the same kind (median rows: ratio of the medians).\n\n"]
+          "VQF of the same kind (median rows: ratio of the medians). Our filters with "
+          f"{config_note(config)}; VQF's 6-axis filter with its defaults.\n\n"]
     if missing:
         md.append("Not run: " + ", ".join(f"{f} ({_available(f)})" for f in missing) + "\n\n")
     md.append("## Total / inclination RMSE (°)\n\n" + table)

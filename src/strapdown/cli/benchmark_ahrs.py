@@ -5,8 +5,12 @@ recordings (``--suite openaxes``, 6-axis)."""
 from __future__ import annotations
 
 import argparse
+from typing import TYPE_CHECKING
 
 from strapdown.cli._common import progress, progress_args, say
+
+if TYPE_CHECKING:
+    from strapdown.ahrs import AhrsConfig
 
 __all__ = ["add_parser", "run"]
 
@@ -55,16 +59,28 @@ def _arguments(p: argparse.ArgumentParser) -> None:
                    help="generalisation: seed of the sensor errors and random motions")
     p.add_argument("--short", action="store_true",
                    help="generalisation: the first 12 s of each scenario only (a quick check)")
+    p.add_argument("--set", dest="config", action="append", default=[], metavar="FIELD=VALUE",
+                   help="an AhrsConfig field of our filters (repeatable; every suite), e.g. "
+                   "--set gyro_scale_sigma=0.01; the peers keep their defaults and the report "
+                   "names what was changed")
     progress_args(p, "a line as each trial and filter runs")
 
 
-def _generalisation(args: argparse.Namespace) -> int:
+def _config(args: argparse.Namespace) -> AhrsConfig | None:
+    """Our filters' AhrsConfig from ``--set`` (None: no option given, the defaults)."""
+    from strapdown.ahrs import AhrsConfig
+    from strapdown.cli._common import ahrs_config_fields
+
+    return AhrsConfig(**ahrs_config_fields(args.config)) if args.config else None
+
+
+def _generalisation(args: argparse.Namespace, config: AhrsConfig | None) -> int:
     from strapdown.apps.ahrs_generalisation import generalisation, summary_table
 
     if args.dir is not None:
         raise ValueError("--suite generalisation takes no DIR (its recordings are simulated)")
     out = args.out or "reports/benchmark-ahrs-generalisation"
-    res = generalisation(out, seed=args.seed, short=args.short,
+    res = generalisation(out, seed=args.seed, short=args.short, config=config,
                          progress=say if progress(args) else None)
     print(summary_table(res, list(dict.fromkeys(n for n, _ in res))), end="")
     print("cells: total / inclination RMSE (°, BROAD's metric, from 5 s); ratio: ours/VQF "
@@ -73,7 +89,7 @@ def _generalisation(args: argparse.Namespace) -> int:
     return 0
 
 
-def _openaxes(args: argparse.Namespace) -> int:
+def _openaxes(args: argparse.Namespace, config: AhrsConfig | None) -> int:
     import os
 
     from strapdown.apps.ahrs_openaxes import SETTLE_S, openaxes, summary_table
@@ -81,7 +97,8 @@ def _openaxes(args: argparse.Namespace) -> int:
 
     directory = args.dir if args.dir is not None else os.environ.get(ENV, "")
     out = args.out or "reports/benchmark-ahrs-openaxes"
-    results, suspects = openaxes(directory, out, progress=say if progress(args) else None)
+    results, suspects = openaxes(directory, out, config=config,
+                                 progress=say if progress(args) else None)
     print(summary_table(results, suspects), end="")
     print(f"cells: total / inclination RMSE (°) after fitting a constant world and body "
           f"rotation to each estimate, from {SETTLE_S:g} s on; ratios: ours / VQF of the same "
@@ -93,15 +110,20 @@ def _openaxes(args: argparse.Namespace) -> int:
 def run(args: argparse.Namespace) -> int:
     """Run the benchmark and print each filter's mean RMSE and throughput (BROAD) or the
     per-scenario (generalisation) or per-recording (openaxes) table."""
+    config = _config(args)
+    if config is not None:
+        from strapdown.apps.ahrs_benchmark import config_note
+
+        print(f"our filters with {config_note(config)}")
     if args.suite == "generalisation":
-        return _generalisation(args)
+        return _generalisation(args, config)
     if args.suite == "openaxes":
-        return _openaxes(args)
+        return _openaxes(args, config)
     from strapdown.apps.ahrs_benchmark import FILTERS, KIND, benchmark, mean_of
 
     out = args.out or "reports/benchmark-ahrs"
     res = benchmark("" if args.dir is None else args.dir, out, algorithm=args.algorithm,
-                    heading_offset_removed=args.heading_offset_removed,
+                    heading_offset_removed=args.heading_offset_removed, config=config,
                     progress=say if progress(args) else None)
     for f in FILTERS:
         m = mean_of(res, f)
