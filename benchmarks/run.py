@@ -32,6 +32,8 @@ def main(argv: list[str] | None = None) -> int:
             print(f"{r['name']:38s} peak RSS {r['peak_rss_mb']:.0f} MB")
         elif r.get("skipped"):
             print(f"{r['name']:38s} skipped: {r['skipped']}")
+        elif r.get("ratio") is not None:  # a ratio of two records (sculling: ours / peer)
+            print(f"{r['name']:38s} {r['ratio']:11.3g}×")
         elif r.get("samples_per_s"):
             print(f"{r['name']:38s} {r['samples_per_s']:11.3e}/s  "
                   f"{r['ratio_to_numpy_pass']:8.4f} × numpy  {r['peer'] or ''}")
