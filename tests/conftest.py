@@ -28,6 +28,25 @@ def quat_close(p, q, atol):
     return np.all(d <= atol)
 
 
+@pytest.fixture
+def fake_benchmark(monkeypatch):
+    """``benchmark-ahrs``'s BROAD run replaced: it says one stage line when given a progress
+    callback and keeps each call's ``config`` and ``progress``, in order."""
+    from strapdown.apps import ahrs_benchmark
+
+    calls = []
+
+    def benchmark(directory, out, *, algorithm, heading_offset_removed, config=None,
+                  progress=None):
+        calls.append({"config": config, "progress": progress})
+        if progress is not None:
+            progress("01_trial: strapdown-ekf")
+        return {}
+
+    monkeypatch.setattr(ahrs_benchmark, "benchmark", benchmark)
+    return calls
+
+
 def _shared_dir(name: str, env_var: str) -> Path | None:
     """A shared data set: ``$env_var``, else ``shared/data/NAME`` beside this checkout, else
     beside the checkout this one was cloned from (CI clones into a temporary directory)."""

@@ -17,30 +17,13 @@ def fake_reproduction(monkeypatch):
     given = []
 
     def reproduce(out, *, progress=None):
-        given.append(progress)
+        given.append({"progress": progress})
         if progress is not None:
             progress("Table 1: drift constants")
         return f"{out}/report.md"
 
     monkeypatch.setattr(rep, "reproduction", lambda name: types.SimpleNamespace(
         reproduce=reproduce))
-    return given
-
-
-@pytest.fixture
-def fake_benchmark(monkeypatch):
-    from strapdown.apps import ahrs_benchmark
-
-    given = []
-
-    def benchmark(directory, out, *, algorithm, heading_offset_removed, config=None,
-                  progress=None):
-        given.append(progress)
-        if progress is not None:
-            progress("01_trial: strapdown-ekf")
-        return {}
-
-    monkeypatch.setattr(ahrs_benchmark, "benchmark", benchmark)
     return given
 
 
@@ -54,6 +37,6 @@ def test_stage_lines_only_with_progress(request, capsys, command, line):
     assert main([*command, "--progress"]) == 0
     assert capsys.readouterr().err == line + "\n"
     assert main([*command, "--no-progress"]) == 0
-    assert capsys.readouterr().err == "" and given[-1] is None
+    assert capsys.readouterr().err == "" and given[-1]["progress"] is None
     assert main(command) == 0  # neither: only on a terminal (captured stderr is not one)
-    assert capsys.readouterr().err == "" and given[-1] is None
+    assert capsys.readouterr().err == "" and given[-1]["progress"] is None

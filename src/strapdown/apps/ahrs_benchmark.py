@@ -49,8 +49,7 @@ from strapdown.io.broad import BroadTrial, read_broad
 from strapdown.io.report import Report
 
 __all__ = ["ABLATIONS", "COMPARED", "FILTERS", "KIND", "FilterName", "benchmark", "config_note",
-           "mean_of",
-           "mean_total", "run_filter"]
+           "mean_of", "mean_total", "run_filter"]
 
 #: The filters (see the module docstring): the compared ones first, then the ablations.
 FilterName = Literal["strapdown EKF", "strapdown EKF offline", "VQF", "offlineVQF", "Fusion",
