@@ -125,7 +125,9 @@ def test_set_reaches_our_filters_only_and_is_named(tmp_path, capsys, monkeypatch
 
 
 @pytest.mark.parametrize("item, said", [("heading_nois=0.05", "AhrsConfig field"),
-                                        ("gating=maybe", "expected true or false")])
+                                        ("gating=maybe", "expected true or false"),
+                                        ("heading_noise=abc", "--set heading_noise: expected a "
+                                         "number, got 'abc'")])
 def test_a_bad_set_is_refused_before_anything_runs(tmp_path, capsys, item, said):
     with pytest.raises(SystemExit) as exc:
         main(["benchmark-ahrs", "--suite", "generalisation", "--out", str(tmp_path / "r"),

@@ -125,7 +125,8 @@ class CommandParser(Parser):
 def ahrs_config_fields(items: Iterable[str]) -> dict[str, Any]:
     """``--set FIELD=VALUE`` items as AhrsConfig keyword arguments, each value parsed as
     its field's type (bool: true/false/1/0; str; else float). Raises ValueError naming the
-    item on one that is not FIELD=VALUE with an AhrsConfig field, or a bad bool."""
+    item on one that is not FIELD=VALUE with an AhrsConfig field, a bad bool or a bad
+    number."""
     import dataclasses
 
     from strapdown.ahrs import AhrsConfig
@@ -143,8 +144,13 @@ def ahrs_config_fields(items: Iterable[str]) -> dict[str, Any]:
             if value.lower() not in ("true", "false", "1", "0"):
                 raise ValueError(f"--set {key}: expected true or false, got {value!r}")
             kw[key] = value.lower() in ("true", "1")
+        elif isinstance(default, str):
+            kw[key] = value
         else:
-            kw[key] = value if isinstance(default, str) else float(value)
+            try:
+                kw[key] = float(value)
+            except ValueError:
+                raise ValueError(f"--set {key}: expected a number, got {value!r}") from None
     return kw
 
 

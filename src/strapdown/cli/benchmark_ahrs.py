@@ -62,7 +62,7 @@ def _arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--set", dest="config", action="append", default=[], metavar="FIELD=VALUE",
                    help="an AhrsConfig field of our filters (repeatable; every suite), e.g. "
                    "--set gyro_scale_sigma=0.01; the peers keep their defaults and the report "
-                   "names what was changed")
+                   "names what was changed (default: none, our filters' defaults)")
     progress_args(p, "a line as each trial and filter runs")
 
 
