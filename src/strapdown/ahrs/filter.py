@@ -808,7 +808,7 @@ def _moving_window(rec, cfg: AhrsConfig) -> int:
     return max(2, min(rec.t.size, round(cfg.moving_start_window_s / rec.td)))
 
 
-def _start_motion_power(rec, acc, cfg: AhrsConfig) -> float:
+def _start_motion_power(rec, acc, cfg: AhrsConfig, path=None) -> float:
     """A start in motion's initial motion power for the low-pass model (``_kernel``'s
     ``dyn2``, m²/s⁴): over ``moving_start_window_s``, the specific force turned into the
     first sample's frame; the change of its mean from the window's first half to its second,
@@ -818,8 +818,9 @@ def _start_motion_power(rec, acc, cfg: AhrsConfig) -> float:
     each half, adds little (the raw mean square across the mean took a hand-held 600 °/s
     rotation's lever-arm acceleration for motion and cost BROAD's trial 07 cut in motion
     0.96× → 3.05× VQF). The kernel's moving mean square then forgets it with time
-    constant ``acc_lowpass_s``. 0 when the mean is zero."""
-    a = _derotated(rec, acc, _moving_window(rec, cfg))
+    constant ``acc_lowpass_s``. 0 when the mean is zero. ``path``: the gyro's path over
+    that window (:func:`_window_path`), when already computed."""
+    a = _derotated(rec, acc, _moving_window(rec, cfg), path=path)
     m = a.mean(axis=0)
     n = float(np.linalg.norm(m))
     if not n > 0.0:
@@ -871,17 +872,19 @@ def _derotated(rec, x, w: int, q0=None, path=None) -> np.ndarray:
 
 
 def _initial_attitude(rec, acc, mag, have_mag: bool, cfg: AhrsConfig, q0, frame: str,
-                      still: bool):
+                      still: bool, path=None):
     """q_ENU_b at the start and the body-frame field there (None without heading).
 
     Without ``q0``, the initial window's mean specific force and field give the attitude
     by TRIAD (:func:`attitude_from_acc_mag`); a window that is not still is first turned
     into its first sample's frame by the gyro (a rotating body's mean would otherwise
-    average over the rotation: a 1.5 Hz spin turns 270° in half a second).
+    average over the rotation: a 1.5 Hz spin turns 270° in half a second). ``path``: the
+    gyro's path over a moving window (:func:`_window_path`), when already computed.
     """
     if q0 is None:
         w = _init_window(rec, cfg) if still else _moving_window(rec, cfg)
-        path = None if still else _window_path(rec, w)  # one gyro path for both sensors
+        if not still and path is None:  # one gyro path for both sensors
+            path = _window_path(rec, w)
         a = acc[:w] if still else _derotated(rec, acc, w, path=path)
         m0 = None
         if have_mag:
@@ -1114,15 +1117,17 @@ class _Start(typing.NamedTuple):
     motion_power: float = 0.0
 
 
-def _start(rec, acc, cfg: AhrsConfig, q0, mag_reference) -> _Start:
+def _start(rec, acc, cfg: AhrsConfig, q0, mag_reference, still: bool, path=None) -> _Start:
     """The forward pass's :class:`_Start`: a still window's mean specific force's norm is
     gravity as this accelerometer measures it, scale error included. A start in motion
     widens the initial uncertainty only when the attitude is the window's (no ``q0``), and
-    makes the reference field provisional only when it is also learned there."""
-    if _still(rec, acc, cfg):
+    makes the reference field provisional only when it is also learned there. ``path``: the
+    gyro's path over a moving window, when already computed."""
+    if still:
         return _Start(True, float(np.linalg.norm(acc[:_init_window(rec, cfg)].mean(axis=0))),
                       True, cfg.attitude_sigma0)
-    power = _start_motion_power(rec, acc, cfg) if cfg.acc_model == "lowpass" else 0.0
+    power = (_start_motion_power(rec, acc, cfg, path) if cfg.acc_model == "lowpass"
+             else 0.0)
     if q0 is not None:
         return _Start(False, float(cfg.gravity), False, cfg.attitude_sigma0,
                       motion_power=power)
@@ -1140,8 +1145,13 @@ def _setup(t, gyro, acc, mag, cfg: AhrsConfig, q0, gyro_bias0, mag_reference, fr
 def _prepare(rec, acc, mag, have_mag: bool, cfg: AhrsConfig, q0, gyro_bias0, mag_reference,
              frame):
     """:func:`_setup` on a record :func:`_validate` has checked."""
-    start = _start(rec, acc, cfg, q0, mag_reference)
-    q_init, m0 = _initial_attitude(rec, acc, mag, have_mag, cfg, q0, frame, start.still)
+    still = _still(rec, acc, cfg)
+    # a start in motion: one gyro path over its window for what needs it, its motion power
+    # (the low-pass model) and its attitude (without q0)
+    need = not still and (q0 is None or cfg.acc_model == "lowpass")
+    path = _window_path(rec, _moving_window(rec, cfg)) if need else None
+    start = _start(rec, acc, cfg, q0, mag_reference, still, path)
+    q_init, m0 = _initial_attitude(rec, acc, mag, have_mag, cfg, q0, frame, still, path)
     ref = (_reference_field(rec, mag, q_init, m0, q0, mag_reference, cfg) if have_mag
            else (0.0, 0.0, 0.0))
     if gyro_bias0 is not None:
