@@ -204,7 +204,8 @@ def test_backward_low_pass_continues_the_forward_one_and_waits_on_an_exact_spin(
 def test_a_record_that_ends_at_rest_averages_the_rest_afresh_backwards():
     """The suite's vehicle without sensor errors ends with a stop: there the backward pass's
     low-pass averages the rest afresh instead of continuing the forward pass's, which still
-    lags the braking before it. Offline total RMSE from 5 s: 0.416° (0.636° continuing it)."""
+    lags the braking before it. Offline total RMSE from 5 s: 0.737° (1.099° continuing it;
+    0.416° / 0.636° with the motion power a mean square, before 2026-12-04)."""
     from strapdown.ahrs import offline_ekf
     from strapdown.analysis.broad import _angles
     from strapdown.truth.scenarios import record, vehicle
@@ -212,7 +213,7 @@ def test_a_record_that_ends_at_rest_averages_the_rest_afresh_backwards():
     rec = record(vehicle(), 0, noise=False)
     out = offline_ekf(rec.t, rec.gyro, rec.acc, rec.mag)
     total = _angles(quat_multiply(out.q, quat_conjugate(rec.q_n_b)))[0][rec.t >= 5.0]
-    assert np.degrees(np.sqrt(np.mean(total ** 2))) < 0.5
+    assert np.degrees(np.sqrt(np.mean(total ** 2))) < 0.9
 
 
 def test_a_still_end_measures_gravity_for_the_backward_pass():

@@ -1,9 +1,9 @@
 """The AHRS kernel's issue-25 stages, each alone (continues ``test_stages.py``).
 
 The accelerometer weight driven by the data (:func:`_motion_power`,
-:func:`_lowpass_variance`) and the measurements turned back to the state's time
-(:func:`_at_state_time`, then :func:`_delayed_field`), as their plain-Python twins against
-closed forms or an independent computation.
+:func:`_motion_variance`, :func:`_lowpass_variance`) and the measurements turned back to the
+state's time (:func:`_at_state_time`, then :func:`_delayed_field`), as their plain-Python
+twins against closed forms or an independent computation.
 """
 
 from __future__ import annotations
@@ -145,27 +145,61 @@ def test_motion_gains_are_the_exact_discretisations():
 def test_motion_power_of_a_horizontal_step(k):
     """While the low-pass still averages, the slow mean copies it and the power stays. Then a
     horizontal step Δ of the low-passed force: the slow mean closes in geometrically,
-    d_n = Δ (1 − k₂)^{n}, and the power is the exponential mean (gain k) of |d_n|² — here
-    scipy's lfilter of that closed-form sequence. A vertical step adds no power."""
+    d_n = Δ (1 − k₂)^{n}; the power is the exponential mean (gain k) of |d_n|², and the
+    mean the exponential mean of d_n — here scipy's lfilter of those closed-form sequences.
+    A vertical step adds no power."""
     p = _params_of(acc_lowpass_s=0.05, te=0.01)
     assert p.lp_init_n == 5
-    lp, lp2 = np.array([0.1, -0.2, G]), np.zeros(3)
-    assert k._motion_power(0.25, 3, p, lp, lp2) == 0.25 and np.array_equal(lp2, lp)
+    lp, lp2, dmean = np.array([0.1, -0.2, G]), np.zeros(3), np.zeros(3)
+    assert k._motion_power(0.25, 3, p, lp, lp2, dmean) == 0.25 and np.array_equal(lp2, lp)
+    assert not dmean.any()
     delta = np.array([0.3, -0.4, 0.0])
     k2, n = p.dyn_k2, 200
     for step, expect_zero in ((delta, False), (np.array([0.0, 0.0, 0.5]), True)):
-        lp2 = np.array([0.1, -0.2, G])
+        lp2, dmean = np.array([0.1, -0.2, G]), np.zeros(3)
         lp = lp2 + step
-        dyn2, seq = 0.0, []
+        dyn2, seq, means = 0.0, [], []
         for _ in range(n):
-            dyn2 = k._motion_power(dyn2, 5, p, lp, lp2)
+            dyn2 = k._motion_power(dyn2, 5, p, lp, lp2, dmean)
             seq.append(dyn2)
-        d2 = (step[:2] @ step[:2]) * (1 - k2) ** (2 * np.arange(1, n + 1))
-        ref = lfilter([p.dyn_k], [1, p.dyn_k - 1], d2)
+            means.append(dmean.copy())
+        d = step[:, None] * (1 - k2) ** np.arange(1, n + 1)
+        ref = lfilter([p.dyn_k], [1, p.dyn_k - 1], (d[:2] ** 2).sum(axis=0))
         assert np.allclose(seq, ref, rtol=1e-12, atol=0 if expect_zero else 1e-18)
+        ref_mean = lfilter([p.dyn_k], [1, p.dyn_k - 1], d, axis=1).T
+        assert np.allclose(means, ref_mean, rtol=0, atol=1e-12)
         assert np.allclose(lp2, lp - step * (1 - k2) ** n, rtol=0, atol=1e-12)
         if expect_zero:
             assert not any(seq)
+
+
+def test_motion_variance_leaves_out_what_stays(k):
+    """The power the weight uses is the variance of d = lp − lp2 over the window. With the
+    slow mean held (k₂ = 0) a step Δ that stays gives, after n epochs with r = (1 − k)^n,
+    mean square |Δ|² (1 − r) and mean Δ (1 − r): variance |Δ|² r (1 − r), which goes to 0
+    — a tilt error left behind is not motion. A horizontal circle d = A (cos ωt, sin ωt)
+    keeps in steady state the mean square A² and a mean of A k / |1 − (1 − k) e^{−iωh}|:
+    a swing or a turn within the window is motion. Negative round-off is clipped at 0."""
+    p = _params_of(acc_lowpass_s=0.5, te=0.01)._replace(dyn_k2=0.0)
+    kk = p.dyn_k
+    base = np.array([0.1, -0.2, G])
+    delta = np.array([0.3, -0.4, 0.2])
+    lp2, dmean, dyn2 = base.copy(), np.zeros(3), 0.0
+    for n in range(1, 401):
+        dyn2 = k._motion_power(dyn2, 50, p, base + delta, lp2, dmean)
+        r = (1 - kk) ** n
+        assert k._motion_variance(dyn2, dmean) == pytest.approx(0.25 * r * (1 - r),
+                                                                rel=1e-9, abs=1e-15)
+    assert k._motion_variance(dyn2, dmean) < 1e-3 * 0.25  # eight windows on
+    A, w, h = 0.7, 2 * math.pi / 0.8, 0.01
+    lp2, dmean, dyn2 = base.copy(), np.zeros(3), 0.0
+    for n in range(3000):
+        c = A * np.array([math.cos(w * n * h), math.sin(w * n * h), 0.0])
+        dyn2 = k._motion_power(dyn2, 50, p, base + c, lp2, dmean)
+    m2 = (A * kk / abs(1 - (1 - kk) * np.exp(-1j * w * h))) ** 2
+    assert dyn2 == pytest.approx(A * A, rel=1e-9)
+    assert k._motion_variance(dyn2, dmean) == pytest.approx(A * A - m2, rel=1e-6)
+    assert k._motion_variance(1e-3, np.array([0.1, 0.0, 5.0])) == 0.0
 
 
 def test_lowpass_variance_adds_the_leaked_motion(k):

@@ -881,13 +881,15 @@ def _acc_lowpass_model(lp_n, params, C, fk, fn, lp, s0, s1, dx, H, y):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _motion_power(dyn2, lp_n, params, lp, lp2):
+def _motion_power(dyn2, lp_n, params, lp, lp2, dmean):
     """Stage 5, low-pass model: what of the motion acceleration the low-pass lets through,
     seen as the low-passed specific force ``lp`` less a slower mean of it ``lp2`` (time
     constant ``MOTION_SLOW`` × ``acc_lowpass_s``, in the same reference frame) on the
-    horizontal axes; returns its moving mean square (time constant ``acc_lowpass_s``;
-    zero while the low-pass is still averaging). Tilt errors change slowly, gravity not
-    at all: a swing's or a circle's slow acceleration is what moves ``lp`` from ``lp2``."""
+    horizontal axes, ``d = lp − lp2``; returns its moving mean square (time constant
+    ``acc_lowpass_s``; unchanged while the low-pass is still averaging) and keeps its
+    moving mean ``dmean`` over the same window (:func:`_motion_variance`). Tilt errors change
+    slowly, gravity not at all: a swing's or a circle's slow acceleration is what moves
+    ``lp`` from ``lp2``."""
     if lp_n < params.lp_init_n:
         for a in range(3):
             lp2[a] = lp[a]
@@ -895,16 +897,30 @@ def _motion_power(dyn2, lp_n, params, lp, lp2):
     d2 = 0.0
     for a in range(3):
         lp2[a] += params.dyn_k2 * (lp[a] - lp2[a])
+        d = lp[a] - lp2[a]
+        dmean[a] += params.dyn_k * (d - dmean[a])
         if a < 2:
-            d2 += (lp[a] - lp2[a]) ** 2
+            d2 += d * d
     return dyn2 + params.dyn_k * (d2 - dyn2)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _motion_variance(dyn2, dmean):
+    """Stage 5, low-pass model: the motion power the accelerometer's weight uses — the
+    variance of ``d = lp − lp2`` over the window, its mean square ``dyn2`` less the square of
+    its mean ``dmean`` (horizontal axes; :func:`_motion_power`). What the low-pass lets
+    through of a swing, a shake or a turn comes and goes within the window; a step of ``lp``
+    that stays — the tilt error a burst of rotation leaves behind, which the gyro's timing
+    and scale errors make — is in the mean and adds none, so the filter is not made deaf to
+    its own error (docs/algorithms.md, "The accelerometer's weight in motion")."""
+    return max(dyn2 - dmean[0] * dmean[0] - dmean[1] * dmean[1], 0.0)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
 def _lowpass_variance(params, dyn2, T):
     """Stage 5, low-pass model: the measurement variance per horizontal axis, ``R = (n² +
     κ² τ ā²)/T``: the noise density ``n`` (``acc_lowpass_noise``) and the part of the
-    motion acceleration (mean square ``ā²``, :func:`_motion_power`) that the low-pass of
+    motion acceleration (power ``ā²``, :func:`_motion_variance`) that the low-pass of
     time constant ``τ`` lets through — a fraction ``κ`` (``acc_motion_leak``), correlated
     over ``τ``. A body that swings or circles for minutes is weighed by what its
     accelerometer shows, not dragged by it."""
@@ -1534,6 +1550,7 @@ def ekf_kernel(sensors, prop, window, params, init, out):
     # (a start in motion's, or a carried one; Initial.lowpass[3])
     dyn2 = init.lowpass[3] if np.isfinite(init.lowpass[3]) else 0.0
     lp2 = np.zeros(3)  # slow mean of the low-passed specific force
+    dmean = np.zeros(3)  # moving mean of lp − lp2 (_motion_power)
     if lp_n > 0:  # an initial low-pass (Initial.lowpass) is its slow mean's start too
         for a in range(3):
             lp2[a] = lp[a]
@@ -1606,7 +1623,8 @@ def ekf_kernel(sensors, prop, window, params, init, out):
             if params.acc_lowpass:
                 lp_n = _acc_lowpass_model(lp_n, params, C, fk, fn, lp, lp_s0, lp_s1, dx, H_lp,
                                           y2)
-                dyn2 = _motion_power(dyn2, lp_n, params, lp, lp2)
+                dyn2 = _motion_power(dyn2, lp_n, params, lp, lp2, dmean)
+                r_lp = _lowpass_variance(params, _motion_variance(dyn2, dmean), T)
                 # a sustained acceleration (a coordinated turn) does not average out: the
                 # low-passed specific force is then longer than gravity
                 disturbed = params.gating and not _lowpass_plausible(lp, params, g_meas)
@@ -1620,13 +1638,13 @@ def ekf_kernel(sensors, prop, window, params, init, out):
                     # gain is kept off it (_level_update)
                     if not params.use_magnetometer:
                         nis_acc, ok = _level_update(P, H_lp, 3 if nx == 6 else nx,
-                                                    _lowpass_variance(params, dyn2, T), y2,
+                                                    r_lp, y2,
                                                     params.acc_gate_lowpass, params.gating,
                                                     force, params.soft_gate, dx, C, U2, ku,
                                                     kk, S2, Si2)
                     else:
                         nis_acc, ok = _gated_update(P, H_lp, 3 if nx == 6 else nx,
-                                                    _lowpass_variance(params, dyn2, T), y2,
+                                                    r_lp, y2,
                                                     params.acc_gate_lowpass, params.gating,
                                                     force, params.soft_gate, dx, U2, S2,
                                                     Si2)
@@ -1732,6 +1750,7 @@ def ekf_kernel(sensors, prop, window, params, init, out):
             _rotate_small(eps, lp_s0)
             _rotate_small(eps, lp_s1)
             _rotate_small(eps, lp2)
+            _rotate_small(eps, dmean)
         # stage 8: record
         for i in range(4):
             out_q[k, i] = q[i]

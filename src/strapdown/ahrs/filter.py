@@ -195,10 +195,13 @@ class AhrsConfig:
     acc_motion_leak : float
         Fraction κ of the horizontal motion acceleration that the low-pass lets through:
         the low-passed measurement's variance grows by ``κ² τ ā²`` (τ: ``acc_lowpass_s``;
-        ``ā²``: the moving mean square, over τ, of the low-passed reference-frame specific
-        force less a ``MOTION_SLOW`` (4) times slower mean of it, horizontal axes), so a
+        ``ā²``: the variance over τ — moving mean square less the square of the moving
+        mean — of the low-passed reference-frame specific force less a ``MOTION_SLOW`` (4)
+        times slower mean of it, horizontal axes; ``_kernel._motion_variance``), so a
         body whose accelerometer never sees gravity alone — a
-        swing, a circle, a spin at a lever arm — is weighed by what the data show. 0
+        swing, a circle, a spin at a lever arm — is weighed by what the data show, and a
+        tilt error that a burst of rotation leaves behind, which stays in the mean, is not
+        taken for motion (until 2026-12-04 the mean square: docs/reproductions.md). 0
         switches it off. Default 0.25, with ``tilt_rate_noise`` chosen by the
         cross-validation across kinds of data (``benchmarks/ahrs_cv_kinds.py``;
         docs/reproductions.md).
