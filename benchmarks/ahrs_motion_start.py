@@ -1,7 +1,7 @@
 """Records that start in motion: the AHRS generalisation suite cropped to begin mid-motion.
 
 Usage: ``python benchmarks/ahrs_motion_start.py [--start-s 15] [--seeds 0 1] [--out FILE]
-[--broad DIR]``
+[--hard-iron F --soft-iron F] [--broad DIR]``
 
 Every simulated recording of :func:`strapdown.truth.scenarios.suite` starts at rest; a real
 log often does not (a swing already under way, a robot already moving, a shell already
@@ -12,6 +12,11 @@ and 6-axis (no magnetometer), scored against the truth with BROAD's metric
 after removing the constant heading offset, which no filter can know). Prints
 ours / VQF of the same kind, the geometric mean over the seeds (worst seed). Needs the
 ``vqf`` package (``pip install 'strapdown[bench]'``). About five minutes on two cores.
+
+``--hard-iron F --soft-iron F``: every recording's magnetometer uncalibrated, as
+``benchmarks/ahrs_generalisation.py``'s options of the same names draw it (per seed and
+recording, before the cut); the 9-axis errors are then also taken after removing the
+constant heading offset (an uncalibrated field's north is off by a constant part too).
 
 ``--broad DIR``: instead, the BROAD trials of DIR (real recordings, optical truth), each cut
 two seconds into its first movement phase after 10 s, 9-axis, BROAD's metric over the
@@ -32,10 +37,14 @@ from strapdown.analysis.broad import broad_errors
 from strapdown.apps.ahrs_benchmark import vqf_attitude
 from strapdown.truth.scenarios import record, suite
 
+sys.path.insert(0, str(Path(__file__).parent))
+from ahrs_generalisation import uncalibrated  # one definition of the drawn errors
+
 SETTLE_S = 5.0
 
 
-def _run(t, gyro, acc, mag, q_true, six_axis: bool) -> dict[str, float]:
+def _run(t, gyro, acc, mag, q_true, six_axis: bool,
+         offset_removed: bool = False) -> dict[str, float]:
     h = float(t[1] - t[0])
     moving = t >= SETTLE_S
     m = None if six_axis else mag
@@ -45,7 +54,7 @@ def _run(t, gyro, acc, mag, q_true, six_axis: bool) -> dict[str, float]:
            "ours offline": offline_ekf(t, gyro, acc, m).q}
     # without a magnetometer the heading's constant offset is arbitrary (each filter starts
     # at yaw 0 in its own way): taken out before the total, as the OpenAXES suite does
-    key = "total_offset_removed_deg" if six_axis else "total_deg"
+    key = "total_offset_removed_deg" if six_axis or offset_removed else "total_deg"
     return {k: broad_errors(q, q_true, moving, remove_heading_offset=True)[key]
             for k, q in est.items()}
 
@@ -86,6 +95,10 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--start-s", type=float, default=15.0, help="where each record is cut, s")
     ap.add_argument("--seeds", type=int, nargs="+", default=[0, 1])
     ap.add_argument("--out", default=None, help="write every figure as JSON here")
+    ap.add_argument("--hard-iron", type=float, default=0.0,
+                    help="an uncalibrated magnetometer's offset, times the field's norm")
+    ap.add_argument("--soft-iron", type=float, default=0.0,
+                    help="its matrix's error, uniform in (-F, F) per entry")
     ap.add_argument("--broad", default=None, metavar="DIR",
                     help="instead: BROAD's trials of DIR cut two seconds into a movement phase")
     args = ap.parse_args(argv)
@@ -95,12 +108,16 @@ def main(argv: list[str] | None = None) -> int:
     for seed in args.seeds:
         for k, sc in enumerate(suite(seed)):
             rec = record(sc, np.random.SeedSequence([seed, k]))
+            uncal = args.hard_iron > 0.0 or args.soft_iron > 0.0
+            if uncal:
+                rec = uncalibrated(rec, args.hard_iron, args.soft_iron,
+                                   np.random.default_rng([seed, k, 1]))
             i0 = int(np.searchsorted(rec.t, args.start_s))
             cut = [np.ascontiguousarray(a[i0:]) for a in (rec.gyro, rec.acc, rec.mag)]
             t = rec.t[i0:] - rec.t[i0]
             for six in (False, True):
                 name = sc.name + (" (6-axis)" if six else "")
-                res.setdefault(name, []).append(_run(t, *cut, rec.q_n_b[i0:], six))
+                res.setdefault(name, []).append(_run(t, *cut, rec.q_n_b[i0:], six, uncal))
             print(f"seed {seed}: {sc.name}", file=sys.stderr)
     print(f"| scenario, cut at {args.start_s:g} s | ours/VQF causal (worst) "
           "| ours/offlineVQF offline (worst) |")
