@@ -1,7 +1,7 @@
 """Records that start in motion: the AHRS generalisation suite cropped to begin mid-motion.
 
 Usage: ``python benchmarks/ahrs_motion_start.py [--start-s 15] [--seeds 0 1] [--out FILE]
-[--hard-iron F --soft-iron F] [--broad DIR]``
+[--hard-iron F --soft-iron F] [--set FIELD=VALUE ...] [--broad DIR]``
 
 Every simulated recording of :func:`strapdown.truth.scenarios.suite` starts at rest; a real
 log often does not (a swing already under way, a robot already moving, a shell already
@@ -18,6 +18,9 @@ ours / VQF of the same kind, the geometric mean over the seeds (worst seed). Nee
 recording, before the cut); the 9-axis errors are then also taken after removing the
 constant heading offset (an uncalibrated field's north is off by a constant part too).
 
+``--set FIELD=VALUE`` (repeatable) changes our filters' options (an ``AhrsConfig`` field,
+typed by it); VQF's stay its defaults.
+
 ``--broad DIR``: instead, the BROAD trials of DIR (real recordings, optical truth), each cut
 two seconds into its first movement phase after 10 s, 9-axis, BROAD's metric over the
 movement samples from 5 s after the cut; one row per trial and the geometric mean.
@@ -32,9 +35,10 @@ from pathlib import Path
 
 import numpy as np
 
-from strapdown.ahrs.filter import ekf, offline_ekf
+from strapdown.ahrs.filter import AhrsConfig, ekf, offline_ekf
 from strapdown.analysis.broad import broad_errors
 from strapdown.apps.ahrs_benchmark import vqf_attitude
+from strapdown.cli._common import ahrs_config_fields
 from strapdown.truth.scenarios import record, suite
 
 sys.path.insert(0, str(Path(__file__).parent))
@@ -43,15 +47,15 @@ from ahrs_generalisation import uncalibrated  # one definition of the drawn erro
 SETTLE_S = 5.0
 
 
-def _run(t, gyro, acc, mag, q_true, six_axis: bool,
-         offset_removed: bool = False) -> dict[str, float]:
+def _run(t, gyro, acc, mag, q_true, six_axis: bool, offset_removed: bool = False,
+         config: AhrsConfig | None = None) -> dict[str, float]:
     h = float(t[1] - t[0])
     moving = t >= SETTLE_S
     m = None if six_axis else mag
     est = {"VQF": vqf_attitude(gyro, acc, m, h),
            "offlineVQF": vqf_attitude(gyro, acc, m, h, offline=True),
-           "ours": ekf(t, gyro, acc, m).q,
-           "ours offline": offline_ekf(t, gyro, acc, m).q}
+           "ours": ekf(t, gyro, acc, m, config=config).q,
+           "ours offline": offline_ekf(t, gyro, acc, m, config=config).q}
     # without a magnetometer the heading's constant offset is arbitrary (each filter starts
     # at yaw 0 in its own way): taken out before the total, as the OpenAXES suite does
     key = "total_offset_removed_deg" if six_axis or offset_removed else "total_deg"
@@ -59,7 +63,7 @@ def _run(t, gyro, acc, mag, q_true, six_axis: bool,
             for k, q in est.items()}
 
 
-def broad_cut(directory: str) -> int:
+def broad_cut(directory: str, config: AhrsConfig | None = None) -> int:
     """The ``--broad`` table (see the module docstring)."""
     from strapdown.io.broad import read_broad
 
@@ -77,8 +81,8 @@ def broad_cut(directory: str) -> int:
         g, a, m = (np.ascontiguousarray(x[i0:]) for x in (tr.gyro, tr.acc, tr.mag))
         mask = tr.movement[i0:] & (t >= SETTLE_S)
         e = {k: broad_errors(q, tr.q_ref[i0:], mask)["total_deg"] for k, q in (
-            ("ours", ekf(t, g, a, m).q), ("VQF", vqf_attitude(g, a, m, tr.h)),
-            ("ours offline", offline_ekf(t, g, a, m).q),
+            ("ours", ekf(t, g, a, m, config=config).q), ("VQF", vqf_attitude(g, a, m, tr.h)),
+            ("ours offline", offline_ekf(t, g, a, m, config=config).q),
             ("offlineVQF", vqf_attitude(g, a, m, tr.h, offline=True)))}
         rows.append((e["ours"] / e["VQF"], e["ours offline"] / e["offlineVQF"]))
         print(f"| {tr.name} | {e['ours']:.2f} / {e['VQF']:.2f} | {rows[-1][0]:.2f} "
@@ -99,11 +103,19 @@ def main(argv: list[str] | None = None) -> int:
                     help="an uncalibrated magnetometer's offset, times the field's norm")
     ap.add_argument("--soft-iron", type=float, default=0.0,
                     help="its matrix's error, uniform in (-F, F) per entry")
+    ap.add_argument("--set", dest="config", action="append", default=[],
+                    metavar="FIELD=VALUE", help="an AhrsConfig field of our filters")
     ap.add_argument("--broad", default=None, metavar="DIR",
                     help="instead: BROAD's trials of DIR cut two seconds into a movement phase")
     args = ap.parse_args(argv)
+    try:
+        config = AhrsConfig(**ahrs_config_fields(args.config))
+    except ValueError as e:
+        ap.error(str(e))
+    if args.config:
+        print("our filters with " + ", ".join(args.config), file=sys.stderr)
     if args.broad:
-        return broad_cut(args.broad)
+        return broad_cut(args.broad, config)
     res: dict[str, list[dict[str, float]]] = {}
     for seed in args.seeds:
         for k, sc in enumerate(suite(seed)):
@@ -117,7 +129,8 @@ def main(argv: list[str] | None = None) -> int:
             t = rec.t[i0:] - rec.t[i0]
             for six in (False, True):
                 name = sc.name + (" (6-axis)" if six else "")
-                res.setdefault(name, []).append(_run(t, *cut, rec.q_n_b[i0:], six, uncal))
+                res.setdefault(name, []).append(_run(t, *cut, rec.q_n_b[i0:], six, uncal,
+                                                     config))
             print(f"seed {seed}: {sc.name}", file=sys.stderr)
     print(f"| scenario, cut at {args.start_s:g} s | ours/VQF causal (worst) "
           "| ours/offlineVQF offline (worst) |")
