@@ -117,10 +117,10 @@ def main(argv: list[str] | None = None) -> int:
     if args.broad:
         return broad_cut(args.broad, config)
     res: dict[str, list[dict[str, float]]] = {}
+    uncal = args.hard_iron > 0.0 or args.soft_iron > 0.0
     for seed in args.seeds:
         for k, sc in enumerate(suite(seed)):
             rec = record(sc, np.random.SeedSequence([seed, k]))
-            uncal = args.hard_iron > 0.0 or args.soft_iron > 0.0
             if uncal:
                 rec = uncalibrated(rec, args.hard_iron, args.soft_iron,
                                    np.random.default_rng([seed, k, 1]))

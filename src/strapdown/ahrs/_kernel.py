@@ -1624,7 +1624,6 @@ def ekf_kernel(sensors, prop, window, params, init, out):
                 lp_n = _acc_lowpass_model(lp_n, params, C, fk, fn, lp, lp_s0, lp_s1, dx, H_lp,
                                           y2)
                 dyn2 = _motion_power(dyn2, lp_n, params, lp, lp2, dmean)
-                r_lp = _lowpass_variance(params, _motion_variance(dyn2, dmean), T)
                 # a sustained acceleration (a coordinated turn) does not average out: the
                 # low-passed specific force is then longer than gravity
                 disturbed = params.gating and not _lowpass_plausible(lp, params, g_meas)
@@ -1634,17 +1633,16 @@ def ekf_kernel(sensors, prop, window, params, init, out):
                 # few samples in motion is not gravity)
                 if not disturbed and (acc_quiet or (lp_n >= params.lp_init_n + params.lp_settle
                                                        and e >= init.lowpass_wait)):
+                    r_lp = _lowpass_variance(params, _motion_variance(dyn2, dmean), T)
                     # without a field the heading is the gyro's alone: the accelerometer's
                     # gain is kept off it (_level_update)
                     if not params.use_magnetometer:
-                        nis_acc, ok = _level_update(P, H_lp, 3 if nx == 6 else nx,
-                                                    r_lp, y2,
+                        nis_acc, ok = _level_update(P, H_lp, 3 if nx == 6 else nx, r_lp, y2,
                                                     params.acc_gate_lowpass, params.gating,
                                                     force, params.soft_gate, dx, C, U2, ku,
                                                     kk, S2, Si2)
                     else:
-                        nis_acc, ok = _gated_update(P, H_lp, 3 if nx == 6 else nx,
-                                                    r_lp, y2,
+                        nis_acc, ok = _gated_update(P, H_lp, 3 if nx == 6 else nx, r_lp, y2,
                                                     params.acc_gate_lowpass, params.gating,
                                                     force, params.soft_gate, dx, U2, S2,
                                                     Si2)
