@@ -463,6 +463,13 @@ def test_broad_acceptance_against_fusion_and_vqf(tmp_path):
             means = " / ".join(f"{mean_of(res, f, k):.3f}"
                                for k in ("total_deg", "heading_deg", "inclination_deg"))
             assert means in doc, (f, means)
+        # and the README's, to its two decimals
+        readme = (Path(__file__).parents[2] / "README.md").read_text("utf-8")
+        flat = " ".join(readme.split())
+        for ours_f, peer in (("strapdown EKF", "VQF"), ("strapdown EKF offline", "offlineVQF")):
+            claim = (f"{mean_total(res, ours_f):.2f}° {'causal' if peer == 'VQF' else 'offline'}"
+                     f" against {peer}'s {mean_total(res, peer):.2f}°")
+            assert claim in flat, claim
     magnet = "33_disturbed_attached_magnet_2cm"
     assert (res[(magnet, "strapdown EKF")]["total_deg"]
             < 0.9 * res[(magnet, "strapdown EKF, no gating")]["total_deg"])
