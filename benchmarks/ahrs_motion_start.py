@@ -100,14 +100,18 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seeds", type=int, nargs="+", default=[0, 1])
     ap.add_argument("--out", default=None, help="write every figure as JSON here")
     ap.add_argument("--hard-iron", type=float, default=0.0,
-                    help="an uncalibrated magnetometer's offset, times the field's norm")
+                    help="an uncalibrated magnetometer's offset, times the field's norm "
+                    "(default 0: calibrated)")
     ap.add_argument("--soft-iron", type=float, default=0.0,
-                    help="its matrix's error, uniform in (-F, F) per entry")
+                    help="its matrix's error, uniform in (-F, F) per entry (default 0)")
     ap.add_argument("--set", dest="config", action="append", default=[],
-                    metavar="FIELD=VALUE", help="an AhrsConfig field of our filters")
+                    metavar="FIELD=VALUE",
+                    help="an AhrsConfig field of our filters (repeatable; default: none)")
     ap.add_argument("--broad", default=None, metavar="DIR",
                     help="instead: BROAD's trials of DIR cut two seconds into a movement phase")
     args = ap.parse_args(argv)
+    if not (args.hard_iron >= 0.0 and args.soft_iron >= 0.0):
+        ap.error("--hard-iron and --soft-iron are sizes: expected numbers >= 0")
     try:
         config = AhrsConfig(**ahrs_config_fields(args.config))
     except ValueError as e:
