@@ -15,6 +15,7 @@ the compiled filter at the end.
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -978,3 +979,34 @@ def test_a_disturbed_field_is_rejected_for_mag_reject_s_then_used():
     assert skipped[0] == start and np.all(np.diff(skipped) == 1)
     assert skipped.size == pytest.approx(2.0 / h, abs=1)  # the budget
     assert heading[skipped[-1] + 1:].all()
+
+
+def test_a_disturbed_field_used_de_weighted_does_not_teach_the_gyro_bias():
+    """From 5 s on the field is 40 % too strong and turned 3° in heading: disturbed,
+    rejected for mag_reject_s (2 s), then used de-weighted. Its error is the disturbance's,
+    not white noise, so those updates pull the heading but leave the gyro bias alone (the
+    accelerometer and the rest update off, so that only the field could move it); the
+    same field, undisturbed (norm kept, the reference's tolerances wide), teaches it."""
+    h = 0.01
+    n = 1200
+    late = np.arange(n) * h >= 5.0
+    t, gyro, acc, mag = _still(n, h)
+    turned = C_HAT.T @ dcm_from_quat(quat_from_rotvec(np.radians([0.0, 0.0, 3.0]))) @ M_REF
+    cfg = AhrsConfig(mag_reject_s=2.0, gyro_sample="point", use_accelerometer=False,
+                     rest_update=False)
+    for strong, tol in ((1.4, 0.12), (1.0, 0.5)):
+        m = np.where(late[:, None], strong * turned, mag)
+        r = ekf(t, gyro, acc, m, q0=Q_HAT, mag_reference=M_REF,
+                config=replace(cfg, mag_norm_tol=tol, mag_dip_tol=tol))
+        used = (r.flags & Flag.MAG_USED) != 0
+        dist = (r.flags & Flag.MAG_DISTURBED) != 0
+        step = np.abs(np.diff(r.gyro_bias, axis=0)).max(axis=1)
+        if strong > 1.0:
+            de_weighted = np.flatnonzero(used & dist)
+            assert de_weighted.size > 400  # the last 5 s
+            assert np.all(step[de_weighted - 1] == 0.0)
+            start = int(np.argmax(dist))  # the norm's low-pass is over the tolerance
+            assert np.abs(r.gyro_bias[-1] - r.gyro_bias[start - 1]).max() < 1e-15
+        else:
+            assert not dist.any() and np.count_nonzero(used[500:]) > 400
+            assert np.abs(r.gyro_bias[-1] - r.gyro_bias[499]).max() > 1e-6

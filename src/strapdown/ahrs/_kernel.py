@@ -1358,8 +1358,8 @@ def _consider_update(P, H, r, y, gate, gating, force, dx, C, u, K, nb):
     heading measurement weighs less while the tilt is uncertain; the gain
     ``K = P Hᵀ / S`` is then projected: its attitude part onto the reference vertical
     (c = C₃ᵀ in the body frame), zero on the states from ``nb`` on (6: beyond the gyro
-    bias; 3: the gyro bias too, while a start in motion's heading is recovered), and P takes the
-    Joseph form for that gain, ``P − K uᵀ − u Kᵀ + S K Kᵀ`` (u = P Hᵀ), exact for any
+    bias; 3: the gyro bias too, while a start in motion's heading is recovered or a
+    disturbed field is used de-weighted), and P takes the Joseph form for that gain, ``P − K uᵀ − u Kᵀ + S K Kᵀ`` (u = P Hᵀ), exact for any
     gain. dx += K y. Work arrays u, K (n,).
     """
     n = P.shape[0]
@@ -1727,9 +1727,12 @@ def ekf_kernel(sensors, prop, window, params, init, out):
                                                   else 1.0),
                                                y1, params.mag_gate,
                                                params.gating, force, dx, C, ku, kk,
-                                               # the recovered heading of a start in motion
-                                               # is the start's error, not the gyro bias's
-                                               3 if provisional else 6)
+                                               # off the gyro bias: the recovered heading
+                                               # of a start in motion (the start's error,
+                                               # not the bias's), and a disturbed field
+                                               # (its error is not white: it would teach
+                                               # the bias its own drift)
+                                               3 if provisional or dist else 6)
                 bits, mag_bad_since = _outcome(ok, tk, mag_bad_since, F_MAG_USED,
                                                F_MAG_REJECTED)
                 flags |= bits
