@@ -1359,8 +1359,9 @@ def _consider_update(P, H, r, y, gate, gating, force, dx, C, u, K, nb):
     ``K = P Hᵀ / S`` is then projected: its attitude part onto the reference vertical
     (c = C₃ᵀ in the body frame), zero on the states from ``nb`` on (6: beyond the gyro
     bias; 3: the gyro bias too, while a start in motion's heading is recovered or a
-    disturbed field is used de-weighted), and P takes the Joseph form for that gain, ``P − K uᵀ − u Kᵀ + S K Kᵀ`` (u = P Hᵀ), exact for any
-    gain. dx += K y. Work arrays u, K (n,).
+    disturbed field is used de-weighted), and P takes the Joseph form for that gain,
+    ``P − K uᵀ − u Kᵀ + S K Kᵀ`` (u = P Hᵀ), exact for any gain. dx += K y. Work arrays
+    u, K (n,).
     """
     n = P.shape[0]
     for i in range(n):
