@@ -1,7 +1,7 @@
 """Records that start in motion: the AHRS generalisation suite cropped to begin mid-motion.
 
 Usage: ``python benchmarks/ahrs_motion_start.py [--start-s 15] [--seeds 0 1] [--out FILE]
-[--hard-iron F --soft-iron F] [--set FIELD=VALUE ...] [--broad DIR]``
+[--hard-iron F --soft-iron F] [--acc-scale F] [--set FIELD=VALUE ...] [--broad DIR]``
 
 Every simulated recording of :func:`strapdown.truth.scenarios.suite` starts at rest; a real
 log often does not (a swing already under way, a robot already moving, a shell already
@@ -17,6 +17,10 @@ ours / VQF of the same kind, the geometric mean over the seeds (worst seed). Nee
 ``benchmarks/ahrs_generalisation.py``'s options of the same names draw it (per seed and
 recording, before the cut); the 9-axis errors are then also taken after removing the
 constant heading offset (an uncalibrated field's north is off by a constant part too).
+
+``--acc-scale F``: every recording's accelerometer with a scale error, its specific force
+times ``1 + F`` (an untrimmed consumer accelerometer: ±1–2 %; RepoIMU's pendulum segments
+read +0.15, +1.2 and +1.5 % at rest).
 
 ``--set FIELD=VALUE`` (repeatable) changes our filters' options (an ``AhrsConfig`` field,
 typed by it); VQF's stay its defaults.
@@ -104,6 +108,9 @@ def main(argv: list[str] | None = None) -> int:
                     "(default 0: calibrated)")
     ap.add_argument("--soft-iron", type=float, default=0.0,
                     help="its matrix's error, uniform in (-F, F) per entry (default 0)")
+    ap.add_argument("--acc-scale", type=float, default=0.0,
+                    help="an uncalibrated accelerometer: every specific force times 1 + F "
+                    "(default 0)")
     ap.add_argument("--set", dest="config", action="append", default=[],
                     metavar="FIELD=VALUE",
                     help="an AhrsConfig field of our filters (repeatable; default: none)")
@@ -112,6 +119,9 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     if not (args.hard_iron >= 0.0 and args.soft_iron >= 0.0):
         ap.error("--hard-iron and --soft-iron are sizes: expected numbers >= 0")
+    if not -0.5 < args.acc_scale < 0.5:
+        ap.error(f"--acc-scale is a relative error: expected a number in (-0.5, 0.5), got "
+                 f"{args.acc_scale!r}")
     try:
         config = AhrsConfig(**ahrs_config_fields(args.config))
     except ValueError as e:
@@ -129,7 +139,8 @@ def main(argv: list[str] | None = None) -> int:
                 rec = uncalibrated(rec, args.hard_iron, args.soft_iron,
                                    np.random.default_rng([seed, k, 1]))
             i0 = int(np.searchsorted(rec.t, args.start_s))
-            cut = [np.ascontiguousarray(a[i0:]) for a in (rec.gyro, rec.acc, rec.mag)]
+            cut = [np.ascontiguousarray(a[i0:]) for a in
+                   (rec.gyro, (1.0 + args.acc_scale) * rec.acc, rec.mag)]
             t = rec.t[i0:] - rec.t[i0]
             for six in (False, True):
                 name = sc.name + (" (6-axis)" if six else "")

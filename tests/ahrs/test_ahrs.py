@@ -660,6 +660,71 @@ def test_six_axis_accelerometer_leaves_the_heading_to_the_gyro():
     assert e["total_offset_removed_deg"] < 0.12, e
 
 
+def _swing_with_long_accelerometer(scale: float, yaw_rate: float = 0.0, n: int = 3000,
+                                   h: float = 0.01):
+    """A body rocking about its x axis (±0.5 rad at 0.7 Hz, from its fastest point: a start
+    in motion) about the sensor's own point, so that the specific force is gravity's alone,
+    read ``scale`` times too long; with ``yaw_rate`` (rad/s), turning about the vertical
+    too. Returns t, gyro, acc and the true attitude."""
+    from strapdown.rotation.quaternion import quat_conjugate, quat_rotate
+
+    t = np.arange(n) * h
+    om = 2 * np.pi * 0.7
+    theta, dtheta = 0.5 * np.sin(om * t), 0.5 * om * np.cos(om * t)
+    q_roll = np.column_stack([np.cos(theta / 2), np.sin(theta / 2), 0 * t, 0 * t])
+    q_yaw = np.column_stack([np.cos(yaw_rate * t / 2), 0 * t, 0 * t, np.sin(yaw_rate * t / 2)])
+    q = quat_multiply(q_yaw, q_roll)
+    up_body = quat_rotate(quat_conjugate(q), np.array([0.0, 0.0, 1.0]))
+    gyro = np.column_stack([dtheta, 0 * t, 0 * t]) + yaw_rate * up_body
+    acc = scale * AhrsConfig().gravity * up_body
+    return t, gyro, acc, q
+
+
+def test_a_start_in_motion_learns_an_accelerometer_scale_error():
+    """A start in motion never measures gravity's norm at rest; an accelerometer 1.8 % long
+    (within ``acc_scale_tol``, beyond ``acc_lowpass_norm_tol``) fails the low-pass norm
+    test at every epoch against the nominal g. The filter learns the norm from the
+    low-passed force instead and uses the accelerometer from about 10 s on (the low-pass's
+    2.1 s, then a mean over 8.4 s): over the last 10 s every update is used. Switched off
+    (``acc_scale_tol=0``), none is, and the filter says so."""
+    import warnings
+
+    from strapdown.ahrs import AccelerometerUnusedWarning
+
+    t, gyro, acc, _ = _swing_with_long_accelerometer(1.018)
+    late = t >= 20.0
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", AccelerometerUnusedWarning)
+        r = ekf(t, gyro, acc)
+    assert not r.start_still
+    assert np.all((r.flags[late] & Flag.ACC_USED) > 0)
+    with pytest.warns(AccelerometerUnusedWarning):
+        off = ekf(t, gyro, acc, config=AhrsConfig(acc_scale_tol=0.0))
+    assert np.all((off.flags[t >= 3.0] & Flag.ACC_DISTURBED) > 0)
+
+
+@pytest.mark.parametrize("scale,yaw_rate,learned", [
+    (1.025, 0.0, False),  # beyond acc_scale_tol: a sustained acceleration, or worse
+    (1.018, 0.25, False),  # turning at 14 °/s: a turn's centripetal force lengthens it too
+    (1.018, 3.0, True),  # spinning at 3 rad/s about the vertical: no vehicle turns so
+])
+def test_gravity_s_norm_is_not_learned_beyond_the_band_or_in_a_turn(scale, yaw_rate, learned):
+    """The learned norm is used only within ``acc_scale_tol`` of g and not learned while the
+    body turns about the vertical between ``LEARN_MAX_TURN`` and ``LEARN_MIN_SPIN``: the
+    filter then runs as with the learning off, to the last bit."""
+    import warnings
+
+    t, gyro, acc, _ = _swing_with_long_accelerometer(scale, yaw_rate, n=4000)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        on = ekf(t, gyro, acc)
+        off = ekf(t, gyro, acc, config=AhrsConfig(acc_scale_tol=0.0))
+    assert np.array_equal(on.q, off.q) is not learned
+    # the spin's averaged rate crosses the turns' band first (about 9 s), then 8.4 s of mean
+    used = (on.flags[t >= 30.0] & Flag.ACC_USED) > 0
+    assert (np.all(used) if learned else not np.any(used))
+
+
 @pytest.mark.parametrize("run_name", ["ekf", "offline_ekf"])
 def test_an_unused_accelerometer_is_said(run_name):
     """A record that starts in motion and never rests leaves gravity's norm unmeasured; an

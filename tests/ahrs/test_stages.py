@@ -469,6 +469,25 @@ def test_lowpass_plausibility_is_relative_to_measured_gravity(k):
         assert bool(k._lowpass_plausible(gm * (1 + f * 0.015) * up, p, gm)) is ok
 
 
+def test_learned_gravity_is_a_running_mean_then_a_moving_one_within_the_scale_band(k):
+    """While no rest measured gravity: the low-passed force's norm averaged, 1/n until the
+    average spans MOTION_SLOW × acc_lowpass_s (gain dyn_k2), the nominal g in use until
+    then; after it the average when within acc_scale_tol of g, else the nominal."""
+    p = _params_of(acc_scale_tol=0.02)
+    n_slow = math.ceil(1.0 / p.dyn_k2)
+    norms = G * (1.018 + 0.004 * np.sin(np.arange(3 * n_slow)))
+    g, n, ref = G, 0.0, G
+    for i, x in enumerate(norms):
+        g, n, used = k._learn_gravity(np.array([0.0, 0.6, 0.8]) * x, p, g, n)
+        ref += max(p.dyn_k2, 1.0 / (i + 1)) * (x - ref)
+        assert g == pytest.approx(ref, rel=1e-14) and n == i + 1
+        assert used == (G if 1.0 / (i + 1) > p.dyn_k2 else g)
+    assert used == pytest.approx(1.018 * G, rel=2e-3)
+    # a norm further off than the band is not taken for gravity's
+    for off, in_use in ((0.019, True), (0.021, False), (-0.019, True), (-0.021, False)):
+        assert k._gravity_in_use(G * (1 + off), p) == (G * (1 + off) if in_use else G)
+
+
 # ------------------------------------------------------------------ 5b. raw accelerometer
 @pytest.mark.parametrize("nx", [9, 12])
 def test_raw_model_jacobian_and_innovation(k, nx):

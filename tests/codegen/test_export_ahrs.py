@@ -197,6 +197,52 @@ def test_a_start_in_motion_equals_library(tmp_path, algorithm, changes, mag):
     np.testing.assert_array_equal(fl[w - 1:], res.flags[w - 1:])
 
 
+def rocking_start(n=4000, fs=100.0, seed=5, scale=1.018):
+    """A record that starts in motion and never rests: rocking ±0.5 rad at 0.7 Hz about the
+    body's x axis (about the sensor's point: the specific force is gravity's), its
+    accelerometer ``scale`` times too long."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(n) / fs
+    om = 2 * math.pi * 0.7
+    theta = 0.5 * np.sin(om * t)
+    c = dcm_from_quat(np.column_stack([np.cos(theta / 2), np.sin(theta / 2), 0 * t, 0 * t]))
+    acc = np.einsum("nji,j->ni", c, [0.0, 0.0, scale * 9.80665]) + 0.02 * rng.normal(size=(n, 3))
+    mag = np.einsum("nji,j->ni", c, [0.0, 20.0, -40.0]) + 0.3 * rng.normal(size=(n, 3))
+    w = np.column_stack([0.5 * om * np.cos(om * t), 0 * t, 0 * t])
+    gyro = w + [0.01, -0.005, 0.003] + 1e-3 * rng.normal(size=(n, 3))
+    return t, gyro, acc, mag
+
+
+@pytest.mark.parametrize("real", ["double", "float"])
+def test_a_learned_gravity_equals_library(tmp_path, real):
+    """A start in motion with an accelerometer 1.8 % long and no rest: the library learns
+    gravity's norm (``_kernel._learn_gravity``) and uses the accelerometer from about 10 s
+    on, where with the nominal g it would skip every update; the C export row by row as
+    the library: double to ``DOUBLE_RAD`` with the same flags, float within the float
+    bounds."""
+    from strapdown.ahrs import AccelerometerUnusedWarning
+
+    t, gyro, acc, m = rocking_start()
+    res = ekf(t, gyro, acc, m)
+    with pytest.warns(AccelerometerUnusedWarning):
+        off = ekf(t, gyro, acc, m, config=AhrsConfig(acc_scale_tol=0.0))
+    assert not res.start_still
+    assert res.fraction(K.F_ACC_USED) > 0.5 > off.fraction(K.F_ACC_USED)
+    h = check_rate_record(t, gyro, min_samples=4).td
+    e, lib = build(tmp_path, h=h, real=real, mag=True, algorithm="rate-single",
+                   config=AhrsConfig(), name=f"learn_{real}")
+    q, rc, fl = run(e, lib, gyro, acc, m)
+    w = max(e.moving_samples, e.init_samples)
+    err = _compare(res, q, rc, fl, w)
+    if real == "double":
+        assert err.max() <= DOUBLE_RAD, (err.max(), int(err.argmax()))
+        np.testing.assert_array_equal(fl[w - 1:], res.flags[w - 1:])
+    else:
+        deg = np.degrees(err)
+        assert deg.mean() <= FLOAT_MEAN_DEG and deg.max() <= FLOAT_MAX_DEG, (deg.mean(),
+                                                                            deg.max())
+
+
 @pytest.mark.parametrize("real", ["double", "float"])
 def test_an_online_hard_iron_equals_library(tmp_path, real):
     """The online hard-iron estimate (``_kernel._hard_iron_span``): the spun-and-coned record

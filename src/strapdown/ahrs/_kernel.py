@@ -188,9 +188,12 @@ class Params(NamedTuple):
     acc_lowpass_s: float
     acc_motion_leak: float
     acc_lowpass_norm_tol: float
+    acc_scale_tol: float
     gravity_measured: float  #: gravity's norm as this accelerometer measures it: over the
     #: initial window when it is still, else the nominal ``gravity`` until the first rest
     gravity_known: bool  #: gravity_measured was measured (a still start), not assumed
+    gravity_learned: float  #: where the learning of gravity's norm starts (NaN: from
+    #: gravity_measured; _learn_gravity)
     mag_provisional_s: float  #: a moving start: the field's reference norm and dip follow
     #: the measurement this long (the start's tilt, and so its dip, is not yet known)
     acc_gate_lowpass: float
@@ -939,6 +942,48 @@ def _lowpass_plausible(lp, params, g_meas):
     return abs(n - g_meas) <= params.acc_lowpass_norm_tol * g_meas
 
 
+#: Gravity's norm is not learned (:func:`_learn_gravity`) while the rate about the vertical,
+#: averaged as the norm is (time constant ``MOTION_SLOW`` × ``acc_lowpass_s``), lies between
+#: these (rad/s): a turn, whose centripetal acceleration lengthens the low-passed specific
+#: force as a scale error would. A coordinated turn at a bank of 10° (1.5 % longer) turns at
+#: ``g tan φ / v``, 0.03 rad/s at 58 m/s and faster below; no vehicle turns at more than
+#: 2 rad/s at such a bank (it would go at under 0.9 m/s on a 0.4 m circle), while a spin
+#: about a vertical axis, which carries no centripetal acceleration at its axis, does.
+#: Without the test a vehicle cut in a steady turn (at 14.5 °/s, with an accelerometer
+#: 1.5 % short) took its turn for gravity (``benchmarks/ahrs_motion_start.py``).
+LEARN_MAX_TURN = 0.03
+LEARN_MIN_SPIN = 2.0
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _learn_gravity(lp, params, g_learn, n_learn):
+    """Stage 5, low-pass model, while no still start or rest has measured gravity's norm
+    (a start in motion): the norm of the low-passed specific force ``lp``, averaged, is
+    gravity's norm as this accelerometer measures it — a swing's, a shake's or a circle's
+    acceleration averages out of ``lp``, an accelerometer's scale error does not. The
+    average ``g_learn`` over the ``n_learn`` epochs so far is a running mean until it
+    spans ``MOTION_SLOW`` × ``acc_lowpass_s`` (gain ``dyn_k2`` per epoch), then a moving
+    one with that time constant. Returns it, the count and the norm
+    :func:`_lowpass_plausible` tests against: the nominal ``gravity`` until the average
+    spans its time constant, then :func:`_gravity_in_use`'s."""
+    n_learn += 1.0
+    k = max(params.dyn_k2, 1.0 / n_learn)
+    g_learn += k * (np.sqrt(lp[0] ** 2 + lp[1] ** 2 + lp[2] ** 2) - g_learn)
+    if k > params.dyn_k2:
+        return g_learn, n_learn, params.gravity
+    return g_learn, n_learn, _gravity_in_use(g_learn, params)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _gravity_in_use(g_learn, params):
+    """The learned norm of gravity when it lies within ``acc_scale_tol`` of the nominal
+    ``gravity``, else the nominal: a norm further off is a sustained acceleration or an
+    accelerometer worse than the filter allows for, and is not taken for gravity's."""
+    if abs(g_learn - params.gravity) <= params.acc_scale_tol * params.gravity:
+        return g_learn
+    return params.gravity
+
+
 @njit(cache=True, inline="always", error_model="numpy")
 def _acc_plausible(fk, params):
     """Raw model: the specific force's norm is g within ``acc_norm_tol`` (always, without
@@ -1561,6 +1606,16 @@ def ekf_kernel(sensors, prop, window, params, init, out):
     heading_unobserved = False  # the last epoch rejected a disturbed field (heading_bridge_noise)
     g_meas = params.gravity_measured  # gravity's norm as measured (or assumed, g_known false)
     g_known = params.gravity_known
+    # gravity's norm learned from the low-pass while not measured (_learn_gravity): its
+    # average, and the epochs averaged (a carried average counts as settled)
+    g_learn = g_meas
+    n_learn = 0.0
+    if np.isfinite(params.gravity_learned):
+        g_learn = params.gravity_learned
+        n_learn = np.inf
+        if not g_known and params.acc_scale_tol > 0.0:
+            g_meas = _gravity_in_use(g_learn, params)
+    yaw_lp = 0.0  # the rate about the vertical, averaged as g_learn (a turn: no learning)
     mag_dist_prev = False  # the last epoch found the field disturbed
     e = 0
     # start-up outputs of the sliding scheme (samples 1 … lag−1 by single-period steps)
@@ -1625,6 +1680,14 @@ def ekf_kernel(sensors, prop, window, params, init, out):
                 lp_n = _acc_lowpass_model(lp_n, params, C, fk, fn, lp, lp_s0, lp_s1, dx, H_lp,
                                           y2)
                 dyn2 = _motion_power(dyn2, lp_n, params, lp, lp2, dmean)
+                if not g_known and params.acc_scale_tol > 0.0:
+                    yaw_lp += params.dyn_k2 * ((C[2, 0] * phi[0] + C[2, 1] * phi[1]
+                                                + C[2, 2] * phi[2]) / T - yaw_lp)
+                    if (lp_n >= params.lp_init_n + params.lp_settle
+                            and e >= init.lowpass_wait
+                            and not LEARN_MAX_TURN < abs(yaw_lp) < LEARN_MIN_SPIN):
+                        g_learn, n_learn, g_meas = _learn_gravity(lp, params, g_learn,
+                                                                  n_learn)
                 # a sustained acceleration (a coordinated turn) does not average out: the
                 # low-passed specific force is then longer than gravity
                 disturbed = params.gating and not _lowpass_plausible(lp, params, g_meas)
@@ -1779,7 +1842,7 @@ def ekf_kernel(sensors, prop, window, params, init, out):
         for a in range(3):
             lp[a] = np.nan
     return (total, g_meas, g_known, hv[V_APP, 0], hv[V_APP, 1], hv[V_APP, 2], lp[0], lp[1],
-            lp[2], dyn2)
+            lp[2], dyn2, g_learn)
 
 
 @njit(cache=True, error_model="numpy")

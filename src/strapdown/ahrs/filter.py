@@ -47,7 +47,8 @@ with the accelerometer and magnetometer handling of Laidig & Seel (2023)):
   initial motion power, the initial attitude uncertainty is ``moving_start_sigma0``, the
   low-pass accelerometer model waits for its low-pass to settle, the field's reference
   norm and dip follow the measurement for ``moving_start_mag_s``, and gravity's norm is
-  the nominal one until the first rest measures it.
+  learned from the low-passed specific force (within ``acc_scale_tol`` of the nominal
+  one, not while the body turns) until the first rest measures it.
 
 :func:`ekf` is causal (one pass, no sample after the estimate's own is used);
 :func:`offline_ekf` adds a backward pass and combines the two (Fraser & Potter
@@ -102,11 +103,11 @@ ACC_UNUSED_SHARE = 0.5
 class AccelerometerUnusedWarning(UserWarning):
     """The low-pass accelerometer model skipped most of its updates because the
     accelerometer's norm disagrees with the gravity the filter assumed, which no rest
-    measured (a start in motion that never came to rest): the tilt there is the gyro's
-    alone. A norm short of it is an accelerometer scale error beyond
-    ``acc_lowpass_norm_tol`` (pass the gravity this accelerometer measures as
-    ``AhrsConfig(gravity=...)``); a long one may also be a sustained acceleration, which
-    the test is there to skip (a coordinated turn)."""
+    measured (a start in motion that never came to rest) nor learned
+    (``AhrsConfig.acc_scale_tol``): the tilt there is the gyro's alone. A norm short of it
+    is an accelerometer scale error beyond ``acc_lowpass_norm_tol`` (pass the gravity this
+    accelerometer measures as ``AhrsConfig(gravity=...)``); a long one may also be a
+    sustained acceleration, which the test is there to skip (a coordinated turn)."""
 
 
 @dataclass(frozen=True)
@@ -213,6 +214,21 @@ class AhrsConfig:
         a sustained acceleration, such as a coordinated turn's, does not average out
         (a horizontal one of a g lengthens it by ≈ a²/2: 1.5 % at 0.17 g, a 10° bank).
         Default 0.015 — physical, not tuned: BROAD's handheld motions never reach it.
+    acc_scale_tol : float
+        The accelerometer scale error the low-pass model allows for while no still
+        start or rest has measured gravity's norm (a start in motion): the norm is then
+        learned as the mean of the low-passed specific force's norm (a running mean, then
+        a moving one over ``MOTION_SLOW`` × ``acc_lowpass_s``, 8.4 s), and
+        ``acc_lowpass_norm_tol`` is taken about it once the mean spans that time, when it
+        lies within this fraction of ``gravity`` — about the nominal otherwise. A swing's
+        or a shake's acceleration averages out, a scale error does not; a sustained turn
+        lengthens the norm too, so nothing is learned while the averaged rate about the
+        vertical is a turn's (``_kernel.LEARN_MAX_TURN`` to ``LEARN_MIN_SPIN``, 0.03–2
+        rad/s). Default 0.02, an untrimmed consumer accelerometer's ±1–2 % (RepoIMU's
+        pendulum: +0.15, +1.2 and +1.5 % by segment; OpenAXES's robot −3.4 and −4.3 %, beyond
+        it, run as with the nominal). 0 switches it off (the nominal g until a rest).
+        Measured: docs/reproductions.md ("An accelerometer that is not calibrated, in a
+        start in motion").
     acc_gate_mode : {"hard", "soft"}
         Beyond the gate: reject (hard, default) or de-weight (soft, Huber-type).
     lever_arm : float
@@ -529,6 +545,7 @@ class AhrsConfig:
     acc_gate_lowpass: float = 13.82
     acc_motion_leak: float = 0.25
     acc_lowpass_norm_tol: float = 0.015
+    acc_scale_tol: float = 0.02
     acc_gate_mode: str = "hard"
     lever_arm: float = 0.1
     acc_norm_tol: float = 0.25
@@ -624,7 +641,7 @@ _NON_NEGATIVE = ("lever_arm", "acc_motion_leak", "tilt_rate_noise", "heading_rat
                  "offline_lowpass_wait",
                  "mag_reject_s", "rest_min_s", "mag_delay_s", "latency_s", "mag_delay_max_s",
                  "mag_disturbed_power", "offline_mag_reject_s", "mag_delay_z", "hard_iron_s",
-                 "hard_iron_hold_s", "hard_iron_min_explained")
+                 "hard_iron_hold_s", "hard_iron_min_explained", "acc_scale_tol")
 
 
 @dataclass(frozen=True)
@@ -965,6 +982,7 @@ def _derived(cfg: AhrsConfig, ref, use_mag: bool, h: float, te: float,
             "acc_lead": (0.5 * h if cfg.gyro_sample == "interval" and cfg.acc_sample == "point"
                          else 0.0),
             "gravity_measured": start.gravity, "gravity_known": start.gravity_known,
+            "gravity_learned": start.gravity_learned,
             "mag_provisional_s": start.mag_provisional_s,
             "hi_on": use_mag and cfg.hard_iron_s > 0, "hi_span": hi_span,
             "hi_forget": math.exp(-hi_span * te / cfg.hard_iron_s) if cfg.hard_iron_s > 0
@@ -1047,7 +1065,8 @@ def _run(rec, acc, mag, prop: K.Propagation, window: K.Window, params: K.Params,
     out.mag_delay[0] = params.mag_delay
     k, g, g_known, *rest = K.ekf_kernel(K.Sensors(np.ascontiguousarray(x), acc, mag,
                                                   float(h)), prop, window, params, init, out)
-    return out, k, (float(g), bool(g_known)), np.array(rest[:3]), np.array(rest[3:])
+    return (out, k, (float(g), bool(g_known), float(rest[7])), np.array(rest[:3]),
+            np.array(rest[3:7]))
 
 
 def _fill_between_epochs(rec, q, bias, last):
@@ -1108,8 +1127,10 @@ class _Start(typing.NamedTuple):
     norm as this accelerometer measures it — measured (``gravity_known``) or, after a
     start in motion, the nominal one until a rest measures it; after a start in motion
     whose attitude comes from the window, its wider initial uncertainty and the time the
-    field's reference follows the measurement (0: not at all); and the low-pass model's
-    initial motion power (a start in motion's, :func:`_start_motion_power`; else 0)."""
+    field's reference follows the measurement (0: not at all); the low-pass model's
+    initial motion power (a start in motion's, :func:`_start_motion_power`; else 0); and,
+    for a backward pass whose forward pass never measured gravity's norm, the norm that
+    pass learned (``AhrsConfig.acc_scale_tol``; NaN: none, the learning starts afresh)."""
 
     still: bool
     gravity: float
@@ -1118,6 +1139,7 @@ class _Start(typing.NamedTuple):
     mag_provisional_s: float = 0.0
     gyro_bias_sigma0: float | None = None  #: None: the config's
     motion_power: float = 0.0
+    gravity_learned: float = math.nan
 
 
 def _start(rec, acc, cfg: AhrsConfig, q0, mag_reference, still: bool, path=None) -> _Start:
@@ -1186,7 +1208,8 @@ def _filter(rec, acc, mag, have_mag: bool, cfg: AhrsConfig, algorithm: str, q_in
             lowpass_wait_s: float = 0.0):
     """One causal pass: the completed per-sample outputs (ENU; with the attitude and bias
     covariances when ``store_covariance``), the epoch mask, gravity's norm at the end,
-    with whether a rest measured it (``(g, known)``), the online hard-iron offset and the
+    with whether a rest measured it and, if not, its learned norm (``(g, known,
+    learned)``; ``AhrsConfig.acc_scale_tol``), the online hard-iron offset and the
     low-pass model's state at the end (``_kernel.Initial.lowpass``). ``lowpass``: that
     state to start from (None: the low-pass averages its first epochs), with no low-pass
     update for ``lowpass_wait_s`` unless the accelerometer is quiet."""
@@ -1264,7 +1287,7 @@ def ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
 
 
 def _backward(rec, acc, mag, have_mag: bool, cfg: AhrsConfig, algorithm: str, fwd, ref,
-              gravity: tuple[float, bool], lowpass):
+              gravity: tuple[float, bool, float], lowpass):
     """The same filter over the time-reversed record (gyro negated), started from the
     forward pass's last attitude and bias and with its reference field; the
     magnetometer, which leads in reversed time, advanced by the forward pass's median
@@ -1296,7 +1319,8 @@ def _backward(rec, acc, mag, have_mag: bool, cfg: AhrsConfig, algorithm: str, fw
     out, epoch, *_ = _filter(rec_b, np.ascontiguousarray(acc[::-1]),
                              np.ascontiguousarray(mag_b), have_mag, cfg_b, algorithm,
                              _backward_start(fwd, rec, cfg), -fwd.gyro_bias[-1], ref,
-                             _Start(True, *gravity, cfg_b.attitude_sigma0), True, lowpass,
+                             _Start(True, gravity[0], gravity[1], cfg_b.attitude_sigma0,
+                                    gravity_learned=gravity[2]), True, lowpass,
                              cfg.offline_lowpass_wait * cfg.acc_lowpass_s)
     _to_stamps(out, rec_b.omega, rec, cfg)
     out.q[0] = fwd.q[-1]  # its start, at the last stamp (_to_stamps keeps a first row)
@@ -1433,7 +1457,8 @@ def offline_ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
     if end_still and not gravity[1]:
         # the forward pass started moving and no rest measured gravity's norm; a still end
         # measures it, as a still start does, for the backward pass, which starts there
-        gravity = (float(np.linalg.norm(acc[-_init_window(rec, cfg):].mean(axis=0))), True)
+        gravity = (float(np.linalg.norm(acc[-_init_window(rec, cfg):].mean(axis=0))), True,
+                   math.nan)
     bwd, _ = _backward(rec, acc, mag, have_mag, cfg_pass, algorithm, fwd, ref, gravity,
                        None if end_still else lowpass)
     _combine(fwd, bwd)
@@ -1470,7 +1495,8 @@ def _clean_field_rejected(flags: np.ndarray) -> float:
     return float(np.count_nonzero(seen & ((flags & int(MeasurementFlag.MAG_REJECTED)) > 0))) / n
 
 
-def _warn_if_accelerometer_unused(result: AhrsResult, acc, gravity: tuple[float, bool],
+def _warn_if_accelerometer_unused(result: AhrsResult, acc,
+                                  gravity: tuple[float, bool, float],
                                   cfg: AhrsConfig, caller: str) -> None:
     """Warn (:class:`AccelerometerUnusedWarning`) when gravity's norm was never measured —
     no still start, no rest, and (offline) no still end — and the (forward) pass skipped
@@ -1478,7 +1504,7 @@ def _warn_if_accelerometer_unused(result: AhrsResult, acc, gravity: tuple[float,
     while the accelerometer's median norm lies further from the assumed gravity than
     ``acc_lowpass_norm_tol``: the filter then ran on the gyro alone, which its result
     would not show. ``acc``: the specific force the filter was given (m/s²)."""
-    g, known = gravity
+    g, known, _ = gravity
     if known or not cfg.gating or cfg.acc_model != "lowpass":
         return
     share = result.fraction(MeasurementFlag.ACC_DISTURBED)

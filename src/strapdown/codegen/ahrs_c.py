@@ -41,7 +41,7 @@ _TEMPLATES = Path(__file__).parent / "templates"
 #: Params fields the filter learns from the record (state, not constants); the low-pass
 #: coefficients (arrays LP, MC); the delay ring's size (a macro); the offline switch.
 LEARNED = ("ref_norm", "ref_dip", "ref_heading", "use_magnetometer", "gravity_measured",
-           "gravity_known", "mag_provisional_s", "lp_settle")
+           "gravity_known", "gravity_learned", "mag_provisional_s", "lp_settle")
 _NOT_IN_PRM = (*LEARNED, "store_covariance", "mag_delay_max", "rest_tau",
                *(f"{p}_{c}" for p in ("lp", "mc") for c in ("b0", "b1", "b2", "a1", "a2")))
 _MATH = ("sqrt", "sin", "cos", "atan2", "asin", "exp", "pow", "fabs")
@@ -171,6 +171,9 @@ def _constants(cfg: AhrsConfig, params: K.Params, prop: dict, h: float, mag: boo
               "MOVING_MAG_S": _lit(cfg.moving_start_mag_s, real),
               "SETTLE_ALWAYS": str(int(cfg.acc_lowpass_settle)),
               "PROVISIONAL_S": _lit(K.PROVISIONAL_RECOVER_S, real),
+              # a start in motion's learning of gravity's norm (_kernel._learn_gravity)
+              "LEARN_MAX_TURN": _lit(K.LEARN_MAX_TURN, real),
+              "LEARN_MIN_SPIN": _lit(K.LEARN_MIN_SPIN, real),
               **_epoch_constants(cfg, params, prop, h, real)}
     lines = [f"#define PREFIX_{k} {v}" for k, v in macros.items()]
     lit = lambda v: _lit(v, real)  # noqa: E731
