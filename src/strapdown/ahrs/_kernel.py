@@ -190,7 +190,8 @@ class Params(NamedTuple):
     acc_lowpass_norm_tol: float
     acc_scale_tol: float
     gravity_measured: float  #: gravity's norm as this accelerometer measures it: over the
-    #: initial window when it is still, else the nominal ``gravity`` until the first rest
+    #: initial window when it is still, else the nominal ``gravity`` (then the learned norm,
+    #: ``acc_scale_tol``) until the first rest
     gravity_known: bool  #: gravity_measured was measured (a still start), not assumed
     gravity_learned: float  #: where the learning of gravity's norm starts (NaN: from
     #: gravity_measured; _learn_gravity)

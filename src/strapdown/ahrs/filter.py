@@ -1125,7 +1125,8 @@ def _result(rec, out: K.Outputs, epoch, frame: str, have_mag: bool, algorithm: s
 class _Start(typing.NamedTuple):
     """How a pass starts: the initial window still (else a start in motion); gravity's
     norm as this accelerometer measures it — measured (``gravity_known``) or, after a
-    start in motion, the nominal one until a rest measures it; after a start in motion
+    start in motion, the nominal one (the kernel then learns it, ``acc_scale_tol``) until a
+    rest measures it; after a start in motion
     whose attitude comes from the window, its wider initial uncertainty and the time the
     field's reference follows the measurement (0: not at all); the low-pass model's
     initial motion power (a start in motion's, :func:`_start_motion_power`; else 0); and,
