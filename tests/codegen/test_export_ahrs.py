@@ -232,7 +232,12 @@ def test_a_learned_gravity_equals_library(tmp_path, real):
     e, lib = build(tmp_path, h=h, real=real, mag=True, algorithm="rate-single",
                    config=AhrsConfig(), name=f"learn_{real}")
     q, rc, fl = run(e, lib, gyro, acc, m)
-    w = max(e.moving_samples, e.init_samples)
+    _equals_library(res, q, rc, fl, max(e.moving_samples, e.init_samples), real)
+
+
+def _equals_library(res, q, rc, fl, w, real):
+    """The C rows from the ``w``-th sample on against the library's: double to
+    ``DOUBLE_RAD`` with the same flags, float within the float bounds."""
     err = _compare(res, q, rc, fl, w)
     if real == "double":
         assert err.max() <= DOUBLE_RAD, (err.max(), int(err.argmax()))
@@ -257,14 +262,7 @@ def test_an_online_hard_iron_equals_library(tmp_path, real):
     e, lib = build(tmp_path, h=h, real=real, mag=True, algorithm="rate-single",
                    config=AhrsConfig(), name=f"hi_{real}")
     q, rc, fl = run(e, lib, gyro, acc, m)
-    w = e.moving_samples  # the record starts in motion
-    err = _compare(res, q, rc, fl, w)
-    if real == "double":
-        assert err.max() <= DOUBLE_RAD, (err.max(), int(err.argmax()))
-        np.testing.assert_array_equal(fl[w - 1:], res.flags[w - 1:])
-    else:
-        deg = np.degrees(err)
-        assert deg.mean() <= FLOAT_MEAN_DEG and deg.max() <= FLOAT_MAX_DEG
+    _equals_library(res, q, rc, fl, e.moving_samples, real)  # the record starts in motion
 
 
 def test_chunks_equal_one_stream(tmp_path):
