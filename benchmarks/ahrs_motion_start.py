@@ -103,12 +103,12 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--start-s", type=float, default=15.0, help="where each record is cut, s")
     ap.add_argument("--seeds", type=int, nargs="+", default=[0, 1])
     ap.add_argument("--out", default=None, help="write every figure as JSON here")
-    ap.add_argument("--hard-iron", type=float, default=0.0,
+    ap.add_argument("--hard-iron", type=float, default=0.0, metavar="F",
                     help="an uncalibrated magnetometer's offset, times the field's norm "
                     "(default 0: calibrated)")
-    ap.add_argument("--soft-iron", type=float, default=0.0,
+    ap.add_argument("--soft-iron", type=float, default=0.0, metavar="F",
                     help="its matrix's error, uniform in (-F, F) per entry (default 0)")
-    ap.add_argument("--acc-scale", type=float, default=0.0,
+    ap.add_argument("--acc-scale", type=float, default=0.0, metavar="F",
                     help="an uncalibrated accelerometer: every specific force times 1 + F "
                     "(default 0)")
     ap.add_argument("--set", dest="config", action="append", default=[],
@@ -129,6 +129,9 @@ def main(argv: list[str] | None = None) -> int:
     if args.config:
         print("our filters with " + ", ".join(args.config), file=sys.stderr)
     if args.broad:
+        if args.hard_iron or args.soft_iron or args.acc_scale:
+            ap.error("--hard-iron, --soft-iron and --acc-scale alter the simulated suite's "
+                     "sensors, not --broad's recordings: give one or the other")
         return broad_cut(args.broad, config)
     res: dict[str, list[dict[str, float]]] = {}
     uncal = args.hard_iron > 0.0 or args.soft_iron > 0.0
