@@ -666,14 +666,13 @@ def _swing_with_long_accelerometer(scale: float, yaw_rate: float = 0.0, n: int =
     in motion) about the sensor's own point, so that the specific force is gravity's alone,
     read ``scale`` times too long; with ``yaw_rate`` (rad/s), turning about the vertical
     too. Returns t, gyro, acc and the true attitude."""
-    from strapdown.rotation.quaternion import quat_conjugate, quat_rotate
+    from strapdown.rotation.quaternion import quat_conjugate, quat_from_rotvec, quat_rotate
 
     t = np.arange(n) * h
     om = 2 * np.pi * 0.7
     theta, dtheta = 0.5 * np.sin(om * t), 0.5 * om * np.cos(om * t)
-    q_roll = np.column_stack([np.cos(theta / 2), np.sin(theta / 2), 0 * t, 0 * t])
-    q_yaw = np.column_stack([np.cos(yaw_rate * t / 2), 0 * t, 0 * t, np.sin(yaw_rate * t / 2)])
-    q = quat_multiply(q_yaw, q_roll)
+    q = quat_multiply(quat_from_rotvec(np.outer(yaw_rate * t, [0.0, 0.0, 1.0])),
+                      quat_from_rotvec(np.outer(theta, [1.0, 0.0, 0.0])))
     up_body = quat_rotate(quat_conjugate(q), np.array([0.0, 0.0, 1.0]))
     gyro = np.column_stack([dtheta, 0 * t, 0 * t]) + yaw_rate * up_body
     acc = scale * AhrsConfig().gravity * up_body

@@ -19,6 +19,7 @@ from strapdown.ahrs import _kernel as K
 from strapdown.algorithms.rate import check_rate_record
 from strapdown.codegen.ahrs_c import generate_ahrs
 from strapdown.rotation.dcm import dcm_from_quat
+from strapdown.rotation.quaternion import quat_from_rotvec
 from strapdown.truth.motions import SpinConing
 
 TEMPLATE = Path(K.__file__).parents[1] / "codegen" / "templates" / "ahrs.c.in"
@@ -204,8 +205,7 @@ def rocking_start(n=4000, fs=100.0, seed=5, scale=1.018):
     rng = np.random.default_rng(seed)
     t = np.arange(n) / fs
     om = 2 * math.pi * 0.7
-    theta = 0.5 * np.sin(om * t)
-    c = dcm_from_quat(np.column_stack([np.cos(theta / 2), np.sin(theta / 2), 0 * t, 0 * t]))
+    c = dcm_from_quat(quat_from_rotvec(np.outer(0.5 * np.sin(om * t), [1.0, 0.0, 0.0])))
     acc = np.einsum("nji,j->ni", c, [0.0, 0.0, scale * 9.80665]) + 0.02 * rng.normal(size=(n, 3))
     mag = np.einsum("nji,j->ni", c, [0.0, 20.0, -40.0]) + 0.3 * rng.normal(size=(n, 3))
     w = np.column_stack([0.5 * om * np.cos(om * t), 0 * t, 0 * t])
