@@ -826,12 +826,31 @@ def test_disturbed_factor_and_mag_recovery(k):
     nd = np.array([REF[0] * 1.05, REF[1] - 0.1])  # inside: at least 1
     assert k._disturbed_factor(p, nd, ms) == pytest.approx(3.0, rel=1e-15)
     P = np.zeros((6, 6))
-    assert k._mag_recovery(p, P, C_HAT, 1.0) == K.F_MAG_RECOVERED
+    assert k._mag_recovery(P, C_HAT, 0.01) == K.F_MAG_RECOVERED
     assert np.allclose(P[:3, :3], 0.01 * np.outer(C_HAT[2], C_HAT[2]), rtol=0, atol=1e-17)
     assert not P[3:].any()
-    P[:] = 0.0  # a start in motion's heading over a 2.5 ms epoch: a quarter of that
-    k._mag_recovery(p, P, C_HAT, 0.0025 / K.PROVISIONAL_RECOVER_S)
-    assert np.allclose(P[:3, :3], 0.0025 * np.outer(C_HAT[2], C_HAT[2]), rtol=0, atol=1e-17)
+
+
+@pytest.mark.parametrize("tau", [0.5, 2.0])
+def test_provisional_heading_is_a_lowpass_of_the_field(tau):
+    """A start in motion's heading while the field's reference is provisional: its variance
+    grows by ``heading_noise² T / τ²`` per epoch against the field's ``heading_noise² / T``,
+    so the steady gain K is that of a first-order low-pass of time constant τ: the
+    Riccati recursion's fixed point has ``K² / (1 − K) = (T / τ)²``, ``K ≈ T / τ`` per
+    epoch, at 50 Hz as at 400 Hz."""
+    cfg = AhrsConfig(moving_start_heading_s=tau)
+    for h in (0.02, 0.0025):
+        p = _params_of(moving_start_heading_s=tau, h=h)
+        assert p.provisional_heading_q == pytest.approx((cfg.heading_noise / tau) ** 2,
+                                                        rel=1e-15)
+        r = cfg.heading_noise ** 2 / h
+        v = 1.0
+        for _ in range(20000):  # the scalar Riccati recursion to its steady state
+            v += h * p.provisional_heading_q
+            v -= v * v / (v + r)
+        gain = v / r  # the gain on the last measurement
+        assert gain ** 2 / (1.0 - gain) == pytest.approx((h / tau) ** 2, rel=1e-9)
+        assert gain == pytest.approx(h / tau, rel=h / tau)
 
 
 @pytest.mark.parametrize("delay", [0, 2, 4])

@@ -102,9 +102,6 @@ X_N, X_PREV, X_MM = range(3)
 #: The slow mean of the low-passed specific force (:func:`_motion_power`) has this many
 #: times the low-pass's time constant.
 MOTION_SLOW = 4.0
-#: After a start in motion the heading is recovered by ``recover_angle²`` per this many
-#: seconds (:func:`_mag_recovery`), whatever the sample rate.
-PROVISIONAL_RECOVER_S = 0.01
 
 
 class Sensors(NamedTuple):
@@ -197,6 +194,8 @@ class Params(NamedTuple):
     #: gravity_measured; _learn_gravity)
     mag_provisional_s: float  #: a moving start: the field's reference norm and dip follow
     #: the measurement this long (the start's tilt, and so its dip, is not yet known)
+    provisional_heading_q: float  #: meanwhile the heading's variance grows by this (rad²/s):
+    #: ``heading_noise² / moving_start_heading_s²``, a low-pass of the field's heading
     acc_gate_lowpass: float
     acc_bias_rw: float
     mag_new_s: float
@@ -1206,12 +1205,13 @@ def _disturbed_factor(params, nd, ms):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _mag_recovery(params, P, C, scale):
+def _mag_recovery(P, C, ra):
     """Stage 6, recovery: inflate the heading covariance (about the reference vertical) by
-    ``recover_angle²`` times ``scale`` (1 for a recovery that is due; ``T /``
-    :data:`PROVISIONAL_RECOVER_S` for a start in motion's heading, so that it follows the
-    field at the same rate at 50 Hz as at 286 Hz); returns its flag."""
-    ra = params.recover_angle ** 2 * scale
+    ``ra`` (rad²): ``recover_angle²`` for a recovery that is due; ``T`` times
+    ``Params.provisional_heading_q`` for a start in motion's heading while the field's
+    reference is provisional, a random walk against the field's ``heading_noise²/T`` that
+    makes the heading a first-order low-pass of the field's, of time constant
+    ``moving_start_heading_s`` whatever the sample rate; returns its flag."""
     for r in range(3):
         for s in range(3):
             P[r, s] += ra * C[2, r] * C[2, s]
@@ -1784,8 +1784,8 @@ def ekf_kernel(sensors, prop, window, params, init, out):
                                     params.recover_mag_s)
                 force = due or provisional
                 if force:
-                    flags |= _mag_recovery(params, P, C,
-                                           1.0 if due else T / PROVISIONAL_RECOVER_S)
+                    flags |= _mag_recovery(P, C, params.recover_angle ** 2 if due
+                                           else T * params.provisional_heading_q)
                 _heading_model(ref_heading, C, mn, dx, H_mag, y1)
                 nis_mag, ok = _consider_update(P, H_mag, params.heading_noise ** 2 / T
                                                * (_disturbed_factor(params, nd, ms) if dist

@@ -46,7 +46,8 @@ with the accelerometer and magnetometer handling of Laidig & Seel (2023)):
   frame by the gyro before they are averaged, their motion sets the low-pass model's
   initial motion power, the initial attitude uncertainty is ``moving_start_sigma0``, the
   low-pass accelerometer model waits for its low-pass to settle, the field's reference
-  norm and dip follow the measurement for ``moving_start_mag_s``, and gravity's norm is
+  norm and dip follow the measurement for ``moving_start_mag_s`` while the heading
+  follows the field's through a low-pass (``moving_start_heading_s``), and gravity's norm is
   learned from the low-passed specific force (within ``acc_scale_tol`` of the nominal
   one, not while the body turns) until the first rest measures it.
 
@@ -518,6 +519,19 @@ class AhrsConfig:
         measurement for this long, s: the dip is measured with the estimated tilt, wrong
         at such a start, and a reference learned from it called the true field
         disturbed and kept the heading from converging. Default 5.
+    moving_start_heading_s : float
+        Meanwhile the heading is recovered at every epoch, its variance grown by
+        ``heading_noise² T / τ²`` against the field's ``heading_noise² / T``, so that it
+        follows the field's heading as a first-order low-pass of this time constant τ, s
+        (the gain per epoch is about T/τ whatever the sample rate): the heading measured at
+        such a start is wrong with the start's tilt, through the field's dip, until the
+        accelerometer has corrected it, and a swinging body's field swings with it.
+        Default 0.4; ``math.inf``: no growth (a running mean). Before, the variance grew by
+        1 rad²/s, a time constant of 13 ms: the heading followed each sample and ended the
+        phase where the field's swing put it (RepoIMU's pendulum: −40° against VQF's −2°
+        on one start). Chosen from 0.013, 0.4, 1, 2 s and ∞ on BROAD's trials and the
+        simulated suite cut in motion, calibrated and not (docs/reproductions.md); 0.4 s
+        keeps the 0.3 m pendulum's start (whose tilt converges last) at 0.39× VQF.
     declination_deg : float
         Magnetic declination (east positive); 0 gives a magnetic-north heading.
     gravity : float
@@ -596,6 +610,7 @@ class AhrsConfig:
     attitude_sigma0: float = 0.05
     moving_start_sigma0: float = 0.3
     moving_start_mag_s: float = 5.0
+    moving_start_heading_s: float = 0.4
     moving_start_window_s: float = 1.0
     declination_deg: float = 0.0
     gravity: float = G
@@ -634,7 +649,7 @@ class AhrsConfig:
 
 
 #: AhrsConfig fields that may be +∞, negative, or zero.
-_MAY_BE_INFINITE = ("mag_reject_s", "offline_mag_reject_s")
+_MAY_BE_INFINITE = ("mag_reject_s", "offline_mag_reject_s", "moving_start_heading_s")
 _ANY_SIGN = ("declination_deg",)
 _NON_NEGATIVE = ("lever_arm", "acc_motion_leak", "tilt_rate_noise", "heading_rate_noise",
                  "gyro_scale_sigma", "offline_heading_rate_noise", "offline_smooth_s",
@@ -984,6 +999,7 @@ def _derived(cfg: AhrsConfig, ref, use_mag: bool, h: float, te: float,
             "gravity_measured": start.gravity, "gravity_known": start.gravity_known,
             "gravity_learned": start.gravity_learned,
             "mag_provisional_s": start.mag_provisional_s,
+            "provisional_heading_q": (cfg.heading_noise / cfg.moving_start_heading_s) ** 2,
             "hi_on": use_mag and cfg.hard_iron_s > 0, "hi_span": hi_span,
             "hi_forget": math.exp(-hi_span * te / cfg.hard_iron_s) if cfg.hard_iron_s > 0
             else 0.0, "hi_ridge": HI_RIDGE, "hi_min_explained": cfg.hard_iron_min_explained,

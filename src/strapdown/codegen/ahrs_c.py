@@ -170,7 +170,6 @@ def _constants(cfg: AhrsConfig, params: K.Params, prop: dict, h: float, mag: boo
               "WINDOW_BIAS_SIGMA0_SQ": _lit(F.window_bias_sigma(cfg, n_init, h) ** 2, real),
               "MOVING_MAG_S": _lit(cfg.moving_start_mag_s, real),
               "SETTLE_ALWAYS": str(int(cfg.acc_lowpass_settle)),
-              "PROVISIONAL_S": _lit(K.PROVISIONAL_RECOVER_S, real),
               # a start in motion's learning of gravity's norm (_kernel._learn_gravity)
               "LEARN_MAX_TURN": _lit(K.LEARN_MAX_TURN, real),
               "LEARN_MIN_SPIN": _lit(K.LEARN_MIN_SPIN, real),
