@@ -138,7 +138,12 @@ class AhrsConfig:
         scale-factor and misalignment errors make the tilt more uncertain the faster
         the sensor turns, ``Q_tilt = tilt_rate_noise² |ω|² T`` on the two horizontal
         axes (0 switches it off). Default 2.1e-3, chosen with ``acc_motion_leak`` by the
-        cross-validation across kinds of data (issue 25); BROAD's alone chose 4.2e-3.
+        cross-validation across kinds of data (issue 25); BROAD's alone chose 4.2e-3. A
+        logger whose timing is worse than its stamps say — about 50 Hz, samples stamped
+        on another clock, a few lost, then placed on a uniform grid — errs in proportion
+        to the rate too, and wants 0.005–0.01 (RepoIMU's pendulum: 1.07× → 0.99× VQF
+        causal at 0.01), at a cost on clean data (the simulated pendulums 0.51–0.74× →
+        1.1×; docs/reproductions.md, "RepoIMU's pendulum").
     heading_rate_noise : float
         The same for the heading axis, applied while the field is undisturbed. Default
         7e-4 (a third of the tilt's): in BROAD's fast rotations the gyro alone drifted
