@@ -1086,7 +1086,7 @@ def _run(rec, acc, mag, prop: K.Propagation, window: K.Window, params: K.Params,
     out.mag_delay[0] = params.mag_delay
     k, g, g_known, *rest = K.ekf_kernel(K.Sensors(np.ascontiguousarray(x), acc, mag,
                                                   float(h)), prop, window, params, init, out)
-    return (out, k, (float(g), bool(g_known), float(rest[7])), np.array(rest[:3]),
+    return (out, k, _Gravity(float(g), bool(g_known), float(rest[7])), np.array(rest[:3]),
             np.array(rest[3:7]))
 
 
@@ -1141,6 +1141,16 @@ def _result(rec, out: K.Outputs, epoch, frame: str, have_mag: bool, algorithm: s
                       out.accel, out.flags, out.nis, out.attitude_sigma, algorithm, cfg,
                       out.acc_bias if cfg.estimate_acc_bias else None,
                       out.mag_delay * rec.td if have_mag else None, smoothed, start.still)
+
+
+class _Gravity(typing.NamedTuple):
+    """Gravity's norm at the end of a pass: as this accelerometer measures it (``norm``),
+    whether a still start or a rest measured it (``known``; else assumed), and, when not,
+    the norm the pass learned (``learned``, ``AhrsConfig.acc_scale_tol``; NaN: none)."""
+
+    norm: float
+    known: bool
+    learned: float
 
 
 class _Start(typing.NamedTuple):
@@ -1230,8 +1240,8 @@ def _filter(rec, acc, mag, have_mag: bool, cfg: AhrsConfig, algorithm: str, q_in
             lowpass_wait_s: float = 0.0):
     """One causal pass: the completed per-sample outputs (ENU; with the attitude and bias
     covariances when ``store_covariance``), the epoch mask, gravity's norm at the end,
-    with whether a rest measured it and, if not, its learned norm (``(g, known,
-    learned)``; ``AhrsConfig.acc_scale_tol``), the online hard-iron offset and the
+    with whether a rest measured it and, if not, its learned norm (:class:`_Gravity`),
+    the online hard-iron offset and the
     low-pass model's state at the end (``_kernel.Initial.lowpass``). ``lowpass``: that
     state to start from (None: the low-pass averages its first epochs), with no low-pass
     update for ``lowpass_wait_s`` unless the accelerometer is quiet."""
@@ -1309,7 +1319,7 @@ def ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
 
 
 def _backward(rec, acc, mag, have_mag: bool, cfg: AhrsConfig, algorithm: str, fwd, ref,
-              gravity: tuple[float, bool, float], lowpass):
+              gravity: _Gravity, lowpass):
     """The same filter over the time-reversed record (gyro negated), started from the
     forward pass's last attitude and bias and with its reference field; the
     magnetometer, which leads in reversed time, advanced by the forward pass's median
@@ -1341,8 +1351,8 @@ def _backward(rec, acc, mag, have_mag: bool, cfg: AhrsConfig, algorithm: str, fw
     out, epoch, *_ = _filter(rec_b, np.ascontiguousarray(acc[::-1]),
                              np.ascontiguousarray(mag_b), have_mag, cfg_b, algorithm,
                              _backward_start(fwd, rec, cfg), -fwd.gyro_bias[-1], ref,
-                             _Start(True, gravity[0], gravity[1], cfg_b.attitude_sigma0,
-                                    gravity_learned=gravity[2]), True, lowpass,
+                             _Start(True, gravity.norm, gravity.known, cfg_b.attitude_sigma0,
+                                    gravity_learned=gravity.learned), True, lowpass,
                              cfg.offline_lowpass_wait * cfg.acc_lowpass_s)
     _to_stamps(out, rec_b.omega, rec, cfg)
     out.q[0] = fwd.q[-1]  # its start, at the last stamp (_to_stamps keeps a first row)
@@ -1492,11 +1502,11 @@ def offline_ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
     # a record that ends at rest: the backward pass's low-pass averages that rest afresh
     # (the forward pass's still lags the motion before it)
     end_still = _still(replace(rec, omega=rec.omega[::-1]), acc[::-1], cfg)
-    if end_still and not gravity[1]:
+    if end_still and not gravity.known:
         # the forward pass started moving and no rest measured gravity's norm; a still end
         # measures it, as a still start does, for the backward pass, which starts there
-        gravity = (float(np.linalg.norm(acc[-_init_window(rec, cfg):].mean(axis=0))), True,
-                   math.nan)
+        gravity = _Gravity(float(np.linalg.norm(acc[-_init_window(rec, cfg):].mean(axis=0))),
+                           True, math.nan)
     bwd, _ = _backward(rec, acc, mag, have_mag, cfg_pass, algorithm, fwd, ref, gravity,
                        None if end_still else lowpass)
     if start.still:
@@ -1536,7 +1546,7 @@ def _clean_field_rejected(flags: np.ndarray) -> float:
 
 
 def _warn_if_accelerometer_unused(result: AhrsResult, acc,
-                                  gravity: tuple[float, bool, float],
+                                  gravity: _Gravity,
                                   cfg: AhrsConfig, caller: str) -> None:
     """Warn (:class:`AccelerometerUnusedWarning`) when gravity's norm was never measured —
     no still start, no rest, and (offline) no still end — and the (forward) pass skipped
@@ -1544,7 +1554,7 @@ def _warn_if_accelerometer_unused(result: AhrsResult, acc,
     while the accelerometer's median norm lies further from the assumed gravity than
     ``acc_lowpass_norm_tol``: the filter then ran on the gyro alone, which its result
     would not show. ``acc``: the specific force the filter was given (m/s²)."""
-    g, known, _ = gravity
+    g, known = gravity.norm, gravity.known
     if known or not cfg.gating or cfg.acc_model != "lowpass":
         return
     share = result.fraction(MeasurementFlag.ACC_DISTURBED)
