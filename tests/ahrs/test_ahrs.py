@@ -617,8 +617,8 @@ def test_offline_keeps_a_still_starts_measured_attitude(monkeypatch):
     args = (tk, gyro[keep], acc[keep], mag[keep])
 
     def rms(r, sel):
-        d = np.clip(np.abs(np.sum(r.q[sel] * q[keep][sel], axis=1)), 0.0, 1.0)
-        return float(np.degrees(np.sqrt(np.mean((2.0 * np.arccos(d)) ** 2))))
+        return float(np.degrees(np.sqrt(np.mean(attitude_error_angle(r.q[sel],
+                                                                     q[keep][sel]) ** 2))))
 
     still, whole = tk < 0.5, tk >= 0.0
     with_rule = offline_ekf(*args)
