@@ -198,6 +198,41 @@ def test_a_start_in_motion_equals_library(tmp_path, algorithm, changes, mag):
     np.testing.assert_array_equal(fl[w - 1:], res.flags[w - 1:])
 
 
+@pytest.mark.parametrize("real", ["double", "float"])
+def test_a_still_start_shorter_than_the_window_equals_library(tmp_path, real):
+    """A record still for 0.35 s, then swinging (the suite's 0.8 m pendulum, 200 Hz): the
+    initial window is not still, its first ``init_still_min_s`` are, and the C starts
+    still over those (their means, the bias's σ of that shorter rest) as the library does,
+    row by row from the window's last sample: double to ``DOUBLE_RAD`` with the same
+    flags, float within the float bounds."""
+    from strapdown.ahrs import filter as F
+
+    t, gyro, acc, m = _released_pendulum()
+    cfg = AhrsConfig()
+    rec = F._validate(t, gyro, acc, m, cfg, "ENU")[0]
+    assert not F._still(rec, acc, cfg) and F._still_window(rec, acc, cfg) > 0
+    res = ekf(t, gyro, acc, m)
+    assert res.start_still
+    h = check_rate_record(t, gyro, min_samples=4).td
+    e, lib = build(tmp_path, h=h, real=real, mag=True, algorithm="rate-single",
+                   config=cfg, name=f"prefix_{real}")
+    q, rc, fl = run(e, lib, gyro, acc, m)
+    _equals_library(res, q, rc, fl, e.init_samples, real)
+
+
+def _released_pendulum(still_s=0.35):
+    """The suite's 0.8 m pendulum (seed 0, its first 8 s), cut ``still_s`` before its
+    release: t, gyro, acc, mag."""
+    from strapdown.truth.scenarios import record, suite
+
+    k, sc = next((k, s) for k, s in enumerate(suite(0)) if s.name == "pendulum-0.8m-45deg")
+    rec = record(sc, np.random.SeedSequence([0, k]), duration_s=8.0)
+    moving = np.linalg.norm(rec.gyro - rec.gyro[:50].mean(axis=0), axis=1) > 0.05
+    i0 = int(np.searchsorted(rec.t, rec.t[np.argmax(moving)] - still_s))
+    return (rec.t[i0:] - rec.t[i0],
+            *(np.ascontiguousarray(x[i0:]) for x in (rec.gyro, rec.acc, rec.mag)))
+
+
 def rocking_start(n=4000, fs=100.0, seed=5, scale=1.018):
     """A record that starts in motion and never rests: rocking ±0.5 rad at 0.7 Hz about the
     body's x axis (about the sensor's point: the specific force is gravity's), its

@@ -5,11 +5,12 @@ The C (``templates/ahrs.c.in``, ``templates/ahrs.h.in``) mirrors
 names the kernel function it repeats; the covariance updates use P's symmetry and zero
 blocks, so the arithmetic differs at round-off (see the template's head) — and runs the
 causal filter of :func:`strapdown.ahrs.ekf` one sample at a time: the initial window
-(``init_window_s``; when it is not still, a start in motion's ``moving_start_window_s``)
-is buffered, its means give the initial attitude, the reference
-field and gravity as the library computes them, then the buffered samples and every
-later one go through the same epochs. In double precision it equals the library to
-round-off (the test suite holds it to 1e-8 rad at every sample on BROAD recordings).
+(``init_window_s``; when neither it nor its first ``init_still_min_s`` is still, a start
+in motion's ``moving_start_window_s``) is buffered, its (still part's) means give the
+initial attitude, the reference field and gravity as the library computes them, then
+the buffered samples and every later one go through the same epochs. In double precision
+it equals the library to round-off (the test suite holds it to 1e-8 rad at every sample on
+BROAD recordings).
 
 What the template does not take from the kernel it takes from here, computed by the
 library's own functions so the values cannot drift: the tuning is the kernel's
@@ -123,14 +124,15 @@ def _moving_samples(cfg: AhrsConfig, h: float) -> int:
 
 
 def _sizes(cfg: AhrsConfig, params: K.Params, prop: dict, mag: bool, n_init: int,
-           n_move: int) -> dict:
+           n_min: int, n_move: int) -> dict:
     """The header's size macros (without the prefix)."""
     stride = int(prop["stride"])
     n_win = max(n_init, n_move)
     dmax = (params.mag_delay_max if params.estimate_mag_delay else params.mag_delay) if mag else 0
     max_off = int(np.max(prop["offsets"])) if len(prop["offsets"]) else 2
     return {"NX": 6 + 3 * (cfg.acc_model == "raw") + 3 * cfg.estimate_acc_bias,
-            "INIT_SAMPLES": n_init, "MOVING_SAMPLES": n_move, "WIN_SAMPLES": n_win,
+            "INIT_SAMPLES": n_init, "STILL_MIN_SAMPLES": n_min, "MOVING_SAMPLES": n_move,
+            "WIN_SAMPLES": n_win,
             "MAG_WINDOW": n_win if mag else 1,
             # the gyro history: a power of two, so that k % XH is a mask
             "XH": 1 << (max(max_off + 1, dmax + 2, 3) - 1).bit_length(), "DMAX": dmax,
@@ -152,7 +154,7 @@ def _epoch_constants(cfg: AhrsConfig, params: K.Params, prop: dict, h: float,
 
 
 def _constants(cfg: AhrsConfig, params: K.Params, prop: dict, h: float, mag: bool,
-               real: str, n_init: int) -> str:
+               real: str, n_init: int, n_min: int) -> str:
     """The .c file's constants: macros, the Params struct, tables, flags."""
     d = math.radians(cfg.declination_deg)
     lead = cfg.latency_s + (0.5 * h if cfg.gyro_sample == "interval" else 0.0)
@@ -168,6 +170,7 @@ def _constants(cfg: AhrsConfig, params: K.Params, prop: dict, h: float, mag: boo
               "MOVING_SIGMA0_SQ": _lit(cfg.moving_start_sigma0 ** 2, real),
               # a still start's gyro bias, measured over the window (filter._window_bias)
               "WINDOW_BIAS_SIGMA0_SQ": _lit(F.window_bias_sigma(cfg, n_init, h) ** 2, real),
+              "WINDOW_MIN_BIAS_SIGMA0_SQ": _lit(F.window_bias_sigma(cfg, n_min, h) ** 2, real),
               "MOVING_MAG_S": _lit(cfg.moving_start_mag_s, real),
               "SETTLE_ALWAYS": str(int(cfg.acc_lowpass_settle)),
               # a start in motion's learning of gravity's norm (_kernel._learn_gravity)
@@ -248,16 +251,19 @@ def generate_ahrs(sample_rate_hz: float | None = None, *, h: float | None = None
     prop = propagation_supported(algorithm)
     params = _params(cfg, mag, h, int(prop["stride"]))
     n_init = max(2, round(cfg.init_window_s / h))
+    # a still start shorter than the window (filter._still_min_window)
+    n_min = max(2, min(n_init, round(cfg.init_still_min_s / h)))
     n_move = _moving_samples(cfg, h)
     sizes = "\n".join(f"#define PREFIX_{k} {v}" for k, v in
-                      _sizes(cfg, params, prop, mag, n_init, n_move).items())
+                      _sizes(cfg, params, prop, mag, n_init, n_min, n_move).items())
     header = (_TEMPLATES / "ahrs.h.in").read_text().replace("@SIZES@", sizes).replace(
         "@INFO@", _info(cfg, algorithm, h, mag, real)).replace("typedef REAL", f"typedef {real}")
     header = header.replace("GUARD", name.upper() + "_H_INCLUDED")
     body = (_TEMPLATES / "ahrs.c.in").read_text()
     if real == "float":
         body = _to_float(body)
-    source = body.replace("@CONSTANTS@", _constants(cfg, params, prop, h, mag, real, n_init))
+    source = body.replace("@CONSTANTS@", _constants(cfg, params, prop, h, mag, real, n_init,
+                                                    n_min))
     return AhrsExport(name, _fill(header, name), _fill(source, name), real, h, mag,
                       algorithm, cfg, n_init, n_move)
 
