@@ -19,6 +19,10 @@ frames' stamps. The reference is the optical quaternion at each kept sample. The
 taken after fitting a constant world and body rotation to each estimate
 (:func:`strapdown.analysis.alignment.aligned_errors`), over the whole record.
 
+The same repository's ``TStick`` folder (a T-shaped stick moved by hand, IMU and optical
+reference both at 100 Hz, so no held rows; 28 trials, tests 02–11) reads the same way: ``DIR``
+that folder and ``--glob 'TStick_Test*_Trial*.csv'``.
+
 Filters: ``ekf`` and ``offline_ekf`` (defaults, or ``--set``), VQF's ``VQF.updateBatch`` and
 ``offlineVQF`` (defaults, 9D). Prints, per recording, total RMSE of each and ours / VQF of
 the same kind; then the means, the ratio of the means, the worst ratio and how many

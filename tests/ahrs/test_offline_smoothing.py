@@ -247,3 +247,59 @@ def test_a_still_end_measures_gravity_for_the_backward_pass():
     assert tilt_deg(fwd.q)[rest].max() > 2.5  # the gyro alone
     assert tilt_deg(off.q)[spin].max() < 0.2
     assert tilt_deg(off.q)[rest].max() < 0.6
+
+
+def _rocking_with_lost_samples(lose: int, n: int = 6000, h: float = 0.01):
+    """A body still for 2 s, then rocking ±0.8 rad at 0.7 Hz about its x axis at the
+    sensor's point (the specific force is gravity's), interval gyro samples, a field with
+    60° of dip; every 7 s, at the swing's fastest, ``lose`` samples are missing from the
+    record, which is then stamped on a uniform grid (a logger that drops samples). Returns
+    t, gyro, acc, mag and the truth at the kept samples."""
+    tt = np.arange(n) * h
+    om = 2 * math.pi * 0.7
+
+    def theta(t):
+        return 0.8 * np.sin(om * np.maximum(t - 2.0, 0.0))
+
+    rate = np.diff(theta(np.r_[-h, tt])) / h
+    q = quat_from_rotvec(np.outer(theta(tt), [1.0, 0.0, 0.0]))
+    rng = np.random.default_rng(1)
+    acc = 9.80665 * quat_rotate(quat_conjugate(q), np.array([0.0, 0.0, 1.0]))
+    acc = acc + 0.02 * rng.normal(size=(n, 3))
+    dip = math.radians(60.0)
+    mag = quat_rotate(quat_conjugate(q), np.array([0.0, math.cos(dip), -math.sin(dip)]))
+    mag = mag + 0.005 * rng.normal(size=(n, 3))
+    gyro = np.column_stack([rate, 0 * tt, 0 * tt]) + 1e-3 * rng.normal(size=(n, 3))
+    keep = np.ones(n, bool)
+    for t0 in np.arange(6.0, 58.0, 7.0):
+        k0 = int(np.argmax(np.abs(rate) * (np.abs(tt - t0) < 0.8)))
+        keep[k0:k0 + lose] = False
+    return np.arange(keep.sum()) * h, gyro[keep], acc[keep], mag[keep], q[keep]
+
+
+def test_where_the_passes_contradict_each_other_the_tilt_is_the_accelerometers(monkeypatch):
+    """``offline_consistency_gate``: a logger that drops four samples at a swing's fastest
+    every 7 s (20° of rotation missing each time) breaks the gyro model both passes share;
+    around each drop one pass is off by it, the other not, their tilt NIS exceeds the gate
+    on 68 % of the samples, and the offline tilt there is the accelerometer's, low-passed
+    forward and backward in the gyro's frame: inclination RMSE from 5 s 3.19° against
+    4.26° without the rule (the causal filter 5.59°). On the same record without drops
+    the passes agree (NIS below 1) and nothing changes."""
+    from strapdown.ahrs import filter as F
+    from strapdown.ahrs import offline_ekf
+    from strapdown.analysis.broad import broad_errors
+
+    seen = []
+    combine = F._combine
+    monkeypatch.setattr(F, "_combine", lambda f, b: seen.append(combine(f, b)) or seen[-1])
+    off = AhrsConfig(offline_consistency_gate=math.inf)
+    t, g, a, m, q = _rocking_with_lost_samples(4)
+    late = t >= 5.0
+    on_deg = broad_errors(offline_ekf(t, g, a, m).q, q, late)["inclination_deg"]
+    assert np.mean(seen[-1] > AhrsConfig().offline_consistency_gate) > 0.5
+    off_deg = broad_errors(offline_ekf(t, g, a, m, config=off).q, q, late)["inclination_deg"]
+    assert on_deg < 0.8 * off_deg, (on_deg, off_deg)
+    t, g, a, m, q = _rocking_with_lost_samples(0)
+    clean = offline_ekf(t, g, a, m)
+    assert seen[-1].max() < 1.0
+    np.testing.assert_array_equal(clean.q, offline_ekf(t, g, a, m, config=off).q)
