@@ -143,9 +143,9 @@ class AhrsConfig:
         cross-validation across kinds of data (issue 25); BROAD's alone chose 4.2e-3. A
         logger whose timing is worse than its stamps say — about 50 Hz, samples stamped
         on another clock, a few lost, then placed on a uniform grid — errs in proportion
-        to the rate too, and wants 0.005–0.01 (RepoIMU's pendulum: 1.07× → 0.99× VQF
-        causal at 0.01), at a cost on clean data (the simulated pendulums 0.51–0.74× →
-        1.1×; docs/reproductions.md, "RepoIMU's pendulum").
+        to the rate too, and wants 0.005–0.01 (RepoIMU's pendulum: 1.02× → 0.95× VQF
+        causal at 0.01, offline 1.00× → 1.01×), at a cost on clean data (the simulated
+        pendulums 0.51–0.74× → 1.1×; docs/reproductions.md, "RepoIMU's pendulum").
     heading_rate_noise : float
         The same for the heading axis, applied while the field is undisturbed. Default
         7e-4 (a third of the tilt's): in BROAD's fast rotations the gyro alone drifted
