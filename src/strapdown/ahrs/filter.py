@@ -1541,7 +1541,9 @@ def _direct_tilt(rec, acc, out: K.Outputs, tilt_nis: np.ndarray, cfg: AhrsConfig
     q_d = quat_multiply(lift, q_g)
     d = quat_multiply(out.q, quat_conjugate(q_d))  # keep the combination's heading
     twist = np.column_stack([d[:, 0], np.zeros(n), np.zeros(n), d[:, 3]])
-    twist /= np.linalg.norm(twist, axis=1, keepdims=True)
+    tn = np.linalg.norm(twist, axis=1)
+    ok &= tn > 0.0  # no heading to keep where the two differ by a half turn about a level axis
+    twist = np.where(ok[:, None], twist / np.where(ok, tn, 1.0)[:, None], [1.0, 0.0, 0.0, 0.0])
     q_d = quat_multiply(twist, q_d)
     weight = np.clip(sosfiltfilt(sos, bad.astype(float), padlen=_SMOOTH_PAD), 0.0, 1.0)
     weight[~ok] = 0.0
