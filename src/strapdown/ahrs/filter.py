@@ -80,6 +80,7 @@ import numpy as np
 from strapdown._core.validation import as_quaternions
 from strapdown.ahrs import _kernel as K
 from strapdown.ahrs.flags import MeasurementFlag
+from strapdown.ahrs.saturation import warn_if_saturated
 from strapdown.rotation.quaternion import quat_from_rotvec, quat_multiply
 
 __all__ = ["AccelerometerUnusedWarning", "AhrsConfig", "AhrsResult", "attitude_from_acc_mag",
@@ -1366,6 +1367,7 @@ def ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
     cfg = config or AhrsConfig()
     rec, acc, mag, have_mag, q_init, b0, ref, start = _setup(t, gyro, acc, mag, cfg, q0,
                                                               gyro_bias0, mag_reference, frame)
+    warn_if_saturated(rec.omega, "ekf")
     out, epoch, gravity, offset, _ = _filter(rec, acc, mag, have_mag, cfg, algorithm, q_init,
                                              b0, ref, start)
     result = replace(_result(rec, out, epoch, frame, have_mag, algorithm, cfg, start),
@@ -1591,6 +1593,7 @@ def offline_ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
     """
     cfg = config or AhrsConfig()
     rec, acc, mag, have_mag = _validate(t, gyro, acc, mag, cfg, frame)
+    warn_if_saturated(rec.omega, "offline_ekf")
     offset = _hard_iron_offset(rec, mag, have_mag, cfg)
     if offset is not None:
         mag = mag - offset

@@ -1,0 +1,109 @@
+"""A gyro past its range: the rate it reads stops at its full scale while the body turns on.
+
+No filter sees the rotation beyond the range: the attitude misses it, by degrees per
+plateau, until the accelerometer and the magnetometer pull it back. RepoIMU's T-stick
+(Szczęsna et al. (2016)) clips at 7.35 rad/s on its x axis on up to a fifth of a trial's
+samples, and every filter is tens of degrees off there (docs/reproductions.md, "RepoIMU's
+T-stick"). :func:`gyro_plateaus` finds the signature in a record and :func:`ekf
+<strapdown.ahrs.ekf>` and :func:`offline_ekf <strapdown.ahrs.offline_ekf>` warn with it
+(:class:`GyroSaturationWarning`); the estimates do not change.
+
+The signature, per axis: plateaus near the axis's largest rate — at least :data:`MIN_RUN`
+samples whose rate changes by no more than :data:`FLAT` of itself per sample — each entered
+by a step of at least :data:`STEP` of the level, at least :data:`MIN_RUNS` of them, at a
+level of at least :data:`MIN_LEVEL`. A smooth peak cannot be both: flat over three samples
+needs a second difference below 0.2 % of the rate per sample², and a step of 2 % into it one
+of 1.8 %. A steady turn or spin is flat but is not entered by a step (the suite's loiter,
+0.06–0.17 rad/s, and its spin at 9.4 rad/s give none), and a robot's constant-rate legs
+(OpenAXES, 0.2–0.45 rad/s, two to three plateaus) lie below :data:`MIN_LEVEL`. Measured
+[m]: none on BROAD's fifteen trials, OpenAXES's sixteen recordings and the suite (seeds 0–4);
+tests 05 and 10 of the T-stick (25–34 plateaus each, 112–1189 samples); RepoIMU's pendulum,
+whose third segments clip at 10.3–10.5 rad/s on 2–26 samples, is not found (its plateaus
+wander by more than :data:`FLAT`).
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+__all__ = ["FLAT", "MIN_LEVEL", "MIN_RUN", "MIN_RUNS", "NEAR", "STEP", "GyroSaturationWarning",
+           "Plateaus", "gyro_plateaus", "warn_if_saturated"]
+
+#: Largest change per sample, relative to the rate, within a plateau.
+FLAT = 0.002
+#: Smallest step, relative to the level, that enters a plateau.
+STEP = 0.02
+#: Plateaus count within this fraction of the axis's largest |rate|.
+NEAR = 0.9
+#: Samples in a plateau, at least.
+MIN_RUN = 3
+#: Plateaus on an axis, at least.
+MIN_RUNS = 2
+#: Smallest level, rad/s: below every MEMS gyro's full scale (the smallest common one,
+#: 125 °/s, is 2.18 rad/s).
+MIN_LEVEL = 2.0
+
+_AXES = "xyz"
+
+
+class GyroSaturationWarning(UserWarning):
+    """The gyro looks clipped at its range (:func:`gyro_plateaus`): the rotation beyond it
+    is missing from every attitude there, ours and any other filter's."""
+
+
+@dataclass(frozen=True)
+class Plateaus:
+    """An axis whose rate stops at a level: ``axis`` (0–2), the number of plateaus
+    ``runs``, their median ``level`` (|rate|, rad/s) and their ``samples`` in all."""
+
+    axis: int
+    runs: int
+    level: float
+    samples: int
+
+
+def gyro_plateaus(omega: ArrayLike) -> list[Plateaus]:
+    """The axes of a gyro record (rad/s, shape (n, 3)) that show a clipped gyro's
+    signature (module docstring); empty when none does."""
+    w = np.abs(np.asarray(omega, dtype=np.float64))
+    if w.ndim != 2 or w.shape[1] != 3:
+        raise ValueError(f"omega must have shape (n, 3), got {w.shape}")
+    found = []
+    for axis in range(3):
+        x = w[:, axis]
+        top = float(x.max()) if x.size else 0.0
+        if not top >= MIN_LEVEL:
+            continue
+        d = np.abs(np.diff(x))
+        # flat[k]: sample k+1 within FLAT of sample k, near the top
+        flat = (x[1:] >= NEAR * top) & (d <= FLAT * x[1:])
+        edges = np.diff(np.concatenate(([0], flat.astype(np.int8), [0])))
+        start, stop = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
+        # a run of flat transitions start … stop−1 spans samples start … stop
+        entered = start >= 1
+        entered[entered] = d[start[entered] - 1] >= STEP * x[start[entered]]
+        keep = entered & (stop - start + 1 >= MIN_RUN)
+        if keep.sum() >= MIN_RUNS:
+            levels = [float(x[a:b + 1].mean()) for a, b in zip(start[keep], stop[keep],
+                                                                strict=True)]
+            found.append(Plateaus(axis, int(keep.sum()), float(np.median(levels)),
+                                  int(np.sum(stop[keep] - start[keep] + 1))))
+    return found
+
+
+def warn_if_saturated(omega: ArrayLike, where: str) -> list[Plateaus]:
+    """Warn (:class:`GyroSaturationWarning`) about every axis :func:`gyro_plateaus` finds,
+    naming ``where`` (the function the record went to); returns them."""
+    found = gyro_plateaus(omega)
+    for p in found:
+        warnings.warn(
+            f"{where}: gyro axis {_AXES[p.axis]} stops at {p.level:.3g} rad/s "
+            f"({np.degrees(p.level):.0f} °/s) on {p.samples} samples in {p.runs} plateaus, "
+            f"each entered by a step: it looks clipped at its range, and the rotation beyond "
+            f"it is missing from the attitude there (a gyro range above the motion's rate "
+            f"avoids it)", GyroSaturationWarning, stacklevel=3)
+    return found

@@ -1,0 +1,73 @@
+"""A gyro past its range (:mod:`strapdown.ahrs.saturation`): the plateaus it leaves are found
+and ``ekf`` / ``offline_ekf`` warn; smooth peaks, steady turns and spins, and slow
+constant-rate legs are not taken for it."""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+import pytest
+
+from strapdown.ahrs import GyroSaturationWarning, ekf, offline_ekf
+from strapdown.ahrs.saturation import MIN_LEVEL, gyro_plateaus
+from strapdown.rotation.quaternion import quat_conjugate, quat_from_rotvec, quat_rotate
+
+
+def _rocking(amplitude_rate: float, clip: float | None, n: int = 3000, h: float = 0.01):
+    """A body rocking about its x axis at 1 Hz, its rate peaking at ``amplitude_rate``
+    (rad/s), read by a gyro clipped at ``clip``; t, gyro, acc (gravity's specific force)."""
+    t = np.arange(n) * h
+    om = 2 * math.pi
+    theta = amplitude_rate / om * np.sin(om * t)
+    q = quat_from_rotvec(np.outer(theta, [1.0, 0.0, 0.0]))
+    rng = np.random.default_rng(3)
+    rate = amplitude_rate * np.cos(om * t) + 2e-4 * rng.normal(size=n)
+    if clip is not None:
+        rate = np.clip(rate, -clip, clip)
+    gyro = np.column_stack([rate, 2e-4 * rng.normal(size=n), 2e-4 * rng.normal(size=n)])
+    acc = 9.80665 * quat_rotate(quat_conjugate(q), np.array([0.0, 0.0, 1.0]))
+    return t, gyro, acc
+
+
+def test_a_clipped_gyro_is_found_and_warned_about():
+    """A rate of 10 rad/s amplitude clipped at 7: the x axis, level 7 rad/s, two plateaus a
+    cycle (0.12 s each, entered by a 0.4 rad/s step); both filters warn, naming the axis
+    and the level."""
+    t, gyro, acc = _rocking(10.0, 7.0)
+    (p,) = gyro_plateaus(gyro)
+    assert p.axis == 0 and p.level == pytest.approx(7.0, abs=1e-3)
+    assert p.runs >= 2 * 29  # two a cycle, 30 cycles (the first may start on one)
+    for run in (ekf, offline_ekf):
+        with pytest.warns(GyroSaturationWarning, match=r"axis x stops at 7 rad/s"):
+            run(t, gyro, acc)
+
+
+@pytest.mark.parametrize("amplitude,clip", [(10.0, None), (6.0, 7.0), (1.0, 0.7)])
+def test_smooth_peaks_and_slow_plateaus_are_not_clipping(amplitude, clip):
+    """The same rocking unclipped, or with a range above its peak rate: smooth peaks, no
+    plateau; clipped at 0.7 rad/s, below ``MIN_LEVEL`` (no gyro's range is so low): not
+    reported."""
+    assert clip is None or clip > amplitude or clip < MIN_LEVEL
+    t, gyro, acc = _rocking(amplitude, clip)
+    assert gyro_plateaus(gyro) == []
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", GyroSaturationWarning)
+        ekf(t, gyro, acc)
+
+
+@pytest.mark.parametrize("name", ["loiter", "spin-coning", "vehicle", "pendulum-0.3m-70deg"])
+def test_the_suites_steady_turns_and_spins_are_not_clipping(name):
+    """A steady turn (the loiter: 0.17 rad/s; the vehicle) and a steady spin (9.4 rad/s,
+    spun up over 3 s) are flat but not entered by a step; the 0.3 m pendulum's undamped
+    peaks (5 rad/s, every swing the same) are smooth."""
+    from strapdown.truth.scenarios import record, suite
+
+    k, sc = next((k, s) for k, s in enumerate(suite(0)) if s.name == name)
+    assert gyro_plateaus(record(sc, np.random.SeedSequence([0, k])).gyro) == []
+
+
+def test_bad_shape_names_the_expected_shape():
+    with pytest.raises(ValueError, match=r"\(n, 3\)"):
+        gyro_plateaus(np.zeros((5, 2)))
