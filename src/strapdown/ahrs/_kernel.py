@@ -1914,3 +1914,47 @@ def hard_iron_sums(q, m, d, lo, hi, normal, rhs):
             for j in range(3):
                 normal[i, j] += a[0, i] * a[0, j] + a[1, i] * a[1, j] + a[2, i] * a[2, j]
     return rr
+
+
+@njit(cache=True, error_model="numpy")
+def gyro_plateau_runs(omega, near, flat, step, min_run, runs, samples, level):
+    """:func:`strapdown.ahrs.saturation.gyro_plateaus`'s pass over the record, per axis
+    ``a``: the plateaus near the axis's largest |rate| (samples at least ``near`` of it
+    whose |rate| changed by at most ``flat`` of itself since the sample before; a run of
+    them, s … e, is the plateau s − 1 … e) that last ``min_run`` samples and are entered by
+    a step of at least ``step`` of the level (sample s − 1 against s − 2). Writes their
+    number ``runs[a]``, their samples ``samples[a]`` and the mean of their mean levels
+    ``level[a]``."""
+    n = omega.shape[0]
+    for a in range(3):
+        top = 0.0
+        for k in range(n):
+            top = max(top, abs(omega[k, a]))
+        runs[a] = 0
+        samples[a] = 0
+        level[a] = 0.0
+        thr = near * top
+        k = 2
+        while k < n:
+            x0 = abs(omega[k - 1, a])
+            x1 = abs(omega[k, a])
+            if not (x1 >= thr and abs(x1 - x0) <= flat * x1):
+                k += 1
+                continue
+            total = x0 + x1
+            e = k
+            while e + 1 < n:
+                y0 = abs(omega[e, a])
+                y1 = abs(omega[e + 1, a])
+                if not (y1 >= thr and abs(y1 - y0) <= flat * y1):
+                    break
+                e += 1
+                total += y1
+            count = e - k + 2
+            if count >= min_run and abs(x0 - abs(omega[k - 2, a])) >= step * x0:
+                runs[a] += 1
+                samples[a] += count
+                level[a] += total / count
+            k = e + 1
+        if runs[a] > 0:
+            level[a] /= runs[a]

@@ -58,7 +58,8 @@ class GyroSaturationWarning(UserWarning):
 @dataclass(frozen=True)
 class Plateaus:
     """An axis whose rate stops at a level: ``axis`` (0–2), the number of plateaus
-    ``runs``, their median ``level`` (|rate|, rad/s) and their ``samples`` in all."""
+    ``runs``, the mean of their levels ``level`` (|rate|, rad/s) and their ``samples`` in
+    all."""
 
     axis: int
     runs: int
@@ -68,31 +69,18 @@ class Plateaus:
 
 def gyro_plateaus(omega: ArrayLike) -> list[Plateaus]:
     """The axes of a gyro record (rad/s, shape (n, 3)) that show a clipped gyro's
-    signature (module docstring); empty when none does."""
-    w = np.abs(np.asarray(omega, dtype=np.float64))
+    signature (module docstring); empty when none does. One compiled pass over the record
+    (:func:`strapdown.ahrs._kernel.gyro_plateau_runs`): it runs before every
+    :func:`~strapdown.ahrs.ekf`."""
+    from strapdown.ahrs import _kernel as K
+
+    w = np.ascontiguousarray(omega, dtype=np.float64)
     if w.ndim != 2 or w.shape[1] != 3:
         raise ValueError(f"omega must have shape (n, 3), got {w.shape}")
-    found = []
-    for axis in range(3):
-        x = w[:, axis]
-        top = float(x.max()) if x.size else 0.0
-        if not top >= MIN_LEVEL:
-            continue
-        d = np.abs(np.diff(x))
-        # flat[k]: sample k+1 within FLAT of sample k, near the top
-        flat = (x[1:] >= NEAR * top) & (d <= FLAT * x[1:])
-        edges = np.diff(np.concatenate(([0], flat.astype(np.int8), [0])))
-        start, stop = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
-        # a run of flat transitions start … stop−1 spans samples start … stop
-        entered = start >= 1
-        entered[entered] = d[start[entered] - 1] >= STEP * x[start[entered]]
-        keep = entered & (stop - start + 1 >= MIN_RUN)
-        if keep.sum() >= MIN_RUNS:
-            levels = [float(x[a:b + 1].mean()) for a, b in zip(start[keep], stop[keep],
-                                                                strict=True)]
-            found.append(Plateaus(axis, int(keep.sum()), float(np.median(levels)),
-                                  int(np.sum(stop[keep] - start[keep] + 1))))
-    return found
+    runs, samples, level = np.zeros(3, np.int64), np.zeros(3, np.int64), np.zeros(3)
+    K.gyro_plateau_runs(w, NEAR, FLAT, STEP, MIN_RUN, runs, samples, level)
+    return [Plateaus(a, int(runs[a]), float(level[a]), int(samples[a])) for a in range(3)
+            if runs[a] >= MIN_RUNS and level[a] >= MIN_LEVEL]
 
 
 def warn_if_saturated(omega: ArrayLike, where: str) -> list[Plateaus]:
