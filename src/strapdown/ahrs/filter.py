@@ -872,15 +872,21 @@ def _validate(t, gyro, acc, mag, cfg: AhrsConfig, frame: str):
     return rec, acc, mag, have_mag
 
 
+def _window_samples(seconds: float, td: float) -> int:
+    """A start's window of ``seconds`` in samples ``td`` apart, at least 2 — here and in the
+    C export (:mod:`strapdown.codegen.ahrs_c`), which buffers it."""
+    return max(2, round(seconds / td))
+
+
 def _init_window(rec, cfg: AhrsConfig) -> int:
     """Samples of the initial window (at least 2, at most the record)."""
-    return max(2, min(rec.t.size, round(cfg.init_window_s / rec.td)))
+    return min(rec.t.size, _window_samples(cfg.init_window_s, rec.td))
 
 
 def _moving_window(rec, cfg: AhrsConfig) -> int:
     """Samples of a start in motion's window (``moving_start_window_s``; at least 2, at
     most the record)."""
-    return max(2, min(rec.t.size, round(cfg.moving_start_window_s / rec.td)))
+    return min(rec.t.size, _window_samples(cfg.moving_start_window_s, rec.td))
 
 
 def _start_motion_power(rec, acc, cfg: AhrsConfig, path=None) -> float:
@@ -921,7 +927,7 @@ def start_is_still(t, gyro, acc, config: AhrsConfig | None = None) -> bool:
 
 def _still_min_window(rec, cfg: AhrsConfig) -> int:
     """Samples of ``init_still_min_s`` (at least 2, at most the initial window)."""
-    return max(2, min(_init_window(rec, cfg), round(cfg.init_still_min_s / rec.td)))
+    return min(_init_window(rec, cfg), _window_samples(cfg.init_still_min_s, rec.td))
 
 
 def _still_window(rec, acc, cfg: AhrsConfig) -> int:
@@ -1461,7 +1467,7 @@ def _combine(fwd, bwd) -> np.ndarray:
     from strapdown.rotation.quaternion import quat_conjugate, rotvec_from_quat
 
     dq = quat_multiply(quat_conjugate(fwd.q), bwd.q)
-    delta = rotvec_from_quat(dq * np.where(dq[:, :1] < 0, -1.0, 1.0))
+    delta = rotvec_from_quat(dq)  # |δ| ≤ π: the log folds the sign of w
     pf, pb = fwd.attitude_cov, bwd.attitude_cov
     c = dcm_from_quat(fwd.q)[:, :2, :]  # the reference frame's horizontal rows of C_n_b
     dn = np.einsum("nij,nj->ni", c, delta)
@@ -1486,27 +1492,47 @@ def _gyro_smooth(rec, out: K.Outputs, cfg: AhrsConfig) -> None:
     √2/(2πτ)) run forward and backward on c's components, then normalised
     (``AhrsConfig.offline_smooth_s``). Skipped when off, or when the record is too short
     or the cut-off above half the sample rate."""
-    from scipy.signal import butter, sosfiltfilt
+    from scipy.signal import sosfiltfilt
 
     from strapdown.rotation.quaternion import quat_conjugate
 
-    tau, n = cfg.offline_smooth_s, rec.t.size
-    fc = math.sqrt(2.0) / (2.0 * math.pi * tau) if tau > 0 else math.inf
-    if not fc < 0.5 / rec.td or n <= _SMOOTH_PAD:
+    sos = _zero_phase_sos(cfg.offline_smooth_s, rec)
+    if sos is None:
         return
-    q_g = np.empty_like(out.q)
-    K.gyro_path(rec.omega, out.gyro_bias, float(rec.td), cfg.gyro_sample == "interval", q_g)
+    q_g = _gyro_path(rec, out, cfg)
     c = quat_multiply(out.q, quat_conjugate(q_g))
     flip = np.einsum("ij,ij->i", c[1:], c[:-1]) < 0
     c[1:] *= np.where(np.logical_xor.accumulate(flip), -1.0, 1.0)[:, None]
-    c = sosfiltfilt(butter(2, fc, fs=1.0 / rec.td, output="sos"), c, axis=0,
-                    padlen=_SMOOTH_PAD)
+    c = sosfiltfilt(sos, c, axis=0, padlen=_SMOOTH_PAD)
     out.q[:] = quat_multiply(c / np.linalg.norm(c, axis=1, keepdims=True), q_g)
 
 
-#: Samples padded at each end by :func:`_gyro_smooth`'s zero-phase filter (scipy's
-#: default for one second-order section); a record must be longer.
+#: Samples padded at each end by the offline steps' zero-phase filter (scipy's default for
+#: one second-order section); a record must be longer.
 _SMOOTH_PAD = 9
+
+
+def _gyro_path(rec, out: K.Outputs, cfg: AhrsConfig) -> np.ndarray:
+    """The bias-corrected gyro's own path at the stamps, from the identity
+    (:func:`_kernel.gyro_path`, ``out``'s gyro bias): what the offline steps smooth about
+    (:func:`_gyro_smooth`) and turn the specific force along (:func:`_direct_tilt`)."""
+    q_g = np.empty_like(out.q)
+    K.gyro_path(rec.omega, out.gyro_bias, float(rec.td), cfg.gyro_sample == "interval", q_g)
+    return q_g
+
+
+def _zero_phase_sos(tau: float, rec):
+    """The second-order Butterworth of time constant ``tau`` (cut-off √2/(2πτ), as
+    :func:`butterworth`) at the record's period, as scipy's second-order sections for the
+    offline steps' forward-backward filtering (``sosfiltfilt``, padded by
+    :data:`_SMOOTH_PAD`); None when ``tau`` is not positive, the cut-off is not below half
+    the sample rate or the record is too short to pad."""
+    from scipy.signal import butter
+
+    fc = math.sqrt(2.0) / (2.0 * math.pi * tau) if tau > 0 else math.inf
+    if not fc < 0.5 / rec.td or rec.t.size <= _SMOOTH_PAD:
+        return None
+    return butter(2, fc, fs=1.0 / rec.td, output="sos")
 
 
 def _direct_tilt(rec, acc, out: K.Outputs, tilt_nis: np.ndarray, cfg: AhrsConfig) -> None:
@@ -1519,18 +1545,16 @@ def _direct_tilt(rec, acc, out: K.Outputs, tilt_nis: np.ndarray, cfg: AhrsConfig
     of Laidig & Seel's (2023) offline VQF — the heading kept. The switch is the indicator
     of the contradiction low-passed the same way, so the estimate moves between the two
     over the low-pass's seconds. Nothing changes where the passes agree everywhere."""
-    from scipy.signal import butter, sosfiltfilt
+    from scipy.signal import sosfiltfilt
 
     from strapdown.rotation.quaternion import quat_conjugate, quat_rotate, rotvec_from_quat
 
-    n, tau = rec.t.size, cfg.acc_lowpass_s
-    fc = math.sqrt(2.0) / (2.0 * math.pi * tau)
+    n = rec.t.size
     bad = tilt_nis > cfg.offline_consistency_gate
-    if not bad.any() or not fc < 0.5 / rec.td or n <= _SMOOTH_PAD:
+    sos = _zero_phase_sos(cfg.acc_lowpass_s, rec) if bad.any() else None
+    if sos is None:
         return
-    sos = butter(2, fc, fs=1.0 / rec.td, output="sos")
-    q_g = np.empty_like(out.q)
-    K.gyro_path(rec.omega, out.gyro_bias, float(rec.td), cfg.gyro_sample == "interval", q_g)
+    q_g = _gyro_path(rec, out, cfg)
     up = sosfiltfilt(sos, quat_rotate(q_g, acc), axis=0, padlen=_SMOOTH_PAD)
     norm = np.linalg.norm(up, axis=1)
     use = norm > 0.0
@@ -1550,7 +1574,7 @@ def _direct_tilt(rec, acc, out: K.Outputs, tilt_nis: np.ndarray, cfg: AhrsConfig
     weight = np.clip(sosfiltfilt(sos, bad.astype(float), padlen=_SMOOTH_PAD), 0.0, 1.0)
     weight[~ok] = 0.0
     dq = quat_multiply(quat_conjugate(out.q), q_d)
-    step = rotvec_from_quat(dq * np.where(dq[:, :1] < 0, -1.0, 1.0))
+    step = rotvec_from_quat(dq)
     out.q[:] = quat_multiply(out.q, quat_from_rotvec(weight[:, None] * step))
 
 

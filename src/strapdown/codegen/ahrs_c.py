@@ -118,11 +118,6 @@ def _table(name: str, ctype: str, values, fmt) -> str:
     return f"static const {ctype} {name}[{len(vals)}] = {{{', '.join(fmt(v) for v in vals)}}};"
 
 
-def _moving_samples(cfg: AhrsConfig, h: float) -> int:
-    """A start in motion's window, samples (filter._moving_window)."""
-    return max(2, round(cfg.moving_start_window_s / h))
-
-
 def _sizes(cfg: AhrsConfig, params: K.Params, prop: dict, mag: bool, n_init: int,
            n_min: int, n_move: int) -> dict:
     """The header's size macros (without the prefix)."""
@@ -250,10 +245,10 @@ def generate_ahrs(sample_rate_hz: float | None = None, *, h: float | None = None
     mag = bool(mag and cfg.use_magnetometer)
     prop = propagation_supported(algorithm)
     params = _params(cfg, mag, h, int(prop["stride"]))
-    n_init = max(2, round(cfg.init_window_s / h))
+    n_init = F._window_samples(cfg.init_window_s, h)
     # a still start shorter than the window (filter._still_min_window)
-    n_min = max(2, min(n_init, round(cfg.init_still_min_s / h)))
-    n_move = _moving_samples(cfg, h)
+    n_min = min(n_init, F._window_samples(cfg.init_still_min_s, h))
+    n_move = F._window_samples(cfg.moving_start_window_s, h)  # filter._moving_window
     sizes = "\n".join(f"#define PREFIX_{k} {v}" for k, v in
                       _sizes(cfg, params, prop, mag, n_init, n_min, n_move).items())
     header = (_TEMPLATES / "ahrs.h.in").read_text().replace("@SIZES@", sizes).replace(
