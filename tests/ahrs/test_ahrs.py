@@ -21,6 +21,7 @@ from strapdown.rotation.error import attitude_error_angle
 from strapdown.rotation.euler import euler_zyx_from_dcm
 from strapdown.rotation.quaternion import quat_multiply
 from strapdown.truth.motions import SpinConing
+from suite_records import released_pendulum
 
 ALGS = ["rate-single", "rate-three", "rate-three:structure=sliding", "rk4", "rotvec:N=3"]
 #: The simulated gyro samples the rate at each stamp (not its mean over the period before).
@@ -691,20 +692,6 @@ def test_a_still_window_measures_the_gyro_bias():
     assert not moving.start_still and np.array_equal(moving.gyro_bias[0], np.zeros(3))
 
 
-def _released_pendulum(still_s: float):
-    """The suite's 0.8 m pendulum (seed 0), cut ``still_s`` before its release: a record
-    that starts still and swings from within its initial window. Returns t, gyro, acc,
-    mag and the truth."""
-    from strapdown.truth.scenarios import record, suite
-
-    k, sc = next((k, s) for k, s in enumerate(suite(0)) if s.name == "pendulum-0.8m-45deg")
-    rec = record(sc, np.random.SeedSequence([0, k]), duration_s=8.0)
-    moving = np.linalg.norm(rec.gyro - rec.gyro[:50].mean(axis=0), axis=1) > 0.05
-    i0 = int(np.searchsorted(rec.t, rec.t[np.argmax(moving)] - still_s))
-    g, a, m = (np.ascontiguousarray(x[i0:]) for x in (rec.gyro, rec.acc, rec.mag))
-    return rec.t[i0:] - rec.t[i0], g, a, m, rec.q_n_b[i0:]
-
-
 def test_a_still_start_shorter_than_the_window():
     """A record still for 0.35 s, then released (a 0.8 m pendulum swinging 45°): its
     0.5 s initial window is not still, its first ``init_still_min_s`` (0.25 s) are, and the
@@ -715,7 +702,7 @@ def test_a_still_start_shorter_than_the_window():
     from strapdown.ahrs import filter as F
     from strapdown.ahrs import start_is_still
 
-    t, g, a, m, q = _released_pendulum(0.35)
+    t, g, a, m, q = released_pendulum(0.35)
     cfg = AhrsConfig()
     n = round(cfg.init_still_min_s / (t[1] - t[0]))
     assert start_is_still(t, g, a)
@@ -732,7 +719,7 @@ def test_a_still_start_shorter_than_the_window():
     assert start.gravity == pytest.approx(float(np.linalg.norm(a[:n].mean(axis=0))), rel=1e-12)
     assert broad_errors(on.q, q, first)["total_deg"] < 2.5
     assert broad_errors(off.q, q, first)["total_deg"] > 5.0
-    assert not start_is_still(*_released_pendulum(0.2)[:3])
+    assert not start_is_still(*released_pendulum(0.2)[:3])
 
 
 def test_six_axis_accelerometer_leaves_the_heading_to_the_gyro():

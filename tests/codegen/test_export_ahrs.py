@@ -21,6 +21,7 @@ from strapdown.codegen.ahrs_c import generate_ahrs
 from strapdown.rotation.dcm import dcm_from_quat
 from strapdown.rotation.quaternion import quat_from_rotvec
 from strapdown.truth.motions import SpinConing
+from suite_records import released_pendulum
 
 TEMPLATE = Path(K.__file__).parents[1] / "codegen" / "templates" / "ahrs.c.in"
 WAIT, ERR_INPUT, ERR_NUMERIC = 1, -1, -3
@@ -207,7 +208,7 @@ def test_a_still_start_shorter_than_the_window_equals_library(tmp_path, real):
     flags, float within the float bounds."""
     from strapdown.ahrs import filter as F
 
-    t, gyro, acc, m = _released_pendulum()
+    t, gyro, acc, m, _truth = released_pendulum()
     cfg = AhrsConfig()
     rec = F._validate(t, gyro, acc, m, cfg, "ENU")[0]
     assert not F._still(rec, acc, cfg) and F._still_window(rec, acc, cfg) > 0
@@ -218,19 +219,6 @@ def test_a_still_start_shorter_than_the_window_equals_library(tmp_path, real):
                    config=cfg, name=f"prefix_{real}")
     q, rc, fl = run(e, lib, gyro, acc, m)
     _equals_library(res, q, rc, fl, e.init_samples, real)
-
-
-def _released_pendulum(still_s=0.35):
-    """The suite's 0.8 m pendulum (seed 0, its first 8 s), cut ``still_s`` before its
-    release: t, gyro, acc, mag."""
-    from strapdown.truth.scenarios import record, suite
-
-    k, sc = next((k, s) for k, s in enumerate(suite(0)) if s.name == "pendulum-0.8m-45deg")
-    rec = record(sc, np.random.SeedSequence([0, k]), duration_s=8.0)
-    moving = np.linalg.norm(rec.gyro - rec.gyro[:50].mean(axis=0), axis=1) > 0.05
-    i0 = int(np.searchsorted(rec.t, rec.t[np.argmax(moving)] - still_s))
-    return (rec.t[i0:] - rec.t[i0],
-            *(np.ascontiguousarray(x[i0:]) for x in (rec.gyro, rec.acc, rec.mag)))
 
 
 def rocking_start(n=4000, fs=100.0, seed=5, scale=1.018):

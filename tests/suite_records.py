@@ -1,0 +1,22 @@
+"""Recordings of the generalisation suite cut for a test, shared by the library's and the C
+export's tests (one definition, so that both check the same record)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["released_pendulum"]
+
+
+def released_pendulum(still_s: float = 0.35):
+    """The suite's 0.8 m pendulum (seed 0, its first 8 s), cut ``still_s`` before its
+    release: a record that starts still and swings from within its initial window. Returns
+    t, gyro, acc, mag and the truth."""
+    from strapdown.truth.scenarios import record, suite
+
+    k, sc = next((k, s) for k, s in enumerate(suite(0)) if s.name == "pendulum-0.8m-45deg")
+    rec = record(sc, np.random.SeedSequence([0, k]), duration_s=8.0)
+    moving = np.linalg.norm(rec.gyro - rec.gyro[:50].mean(axis=0), axis=1) > 0.05
+    i0 = int(np.searchsorted(rec.t, rec.t[np.argmax(moving)] - still_s))
+    g, a, m = (np.ascontiguousarray(x[i0:]) for x in (rec.gyro, rec.acc, rec.mag))
+    return rec.t[i0:] - rec.t[i0], g, a, m, rec.q_n_b[i0:]
