@@ -30,6 +30,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
+from strapdown.ahrs import _kernel as K
+
 __all__ = ["FLAT", "MIN_LEVEL", "MIN_RUN", "MIN_RUNS", "NEAR", "STEP", "GyroSaturationWarning",
            "Plateaus", "gyro_plateaus", "warn_if_saturated"]
 
@@ -72,8 +74,6 @@ def gyro_plateaus(omega: ArrayLike) -> list[Plateaus]:
     signature (module docstring); empty when none does. One compiled pass over the record
     (:func:`strapdown.ahrs._kernel.gyro_plateau_runs`): it runs before every
     :func:`~strapdown.ahrs.ekf`."""
-    from strapdown.ahrs import _kernel as K
-
     w = np.ascontiguousarray(omega, dtype=np.float64)
     if w.ndim != 2 or w.shape[1] != 3:
         raise ValueError(f"omega must have shape (n, 3), got {w.shape}")
