@@ -236,7 +236,7 @@ def test_add_process_noise_splits_tilt_and_heading(k, nx, singer):
     T, phi = 0.01, np.array([0.02, 0.01, -0.03])
     qg, qb, qa, qab = 4e-6 * T, 1e-10, 3e-3, 2e-9
     P = np.zeros((nx, nx))
-    k._add_process_noise(P, C_HAT, phi, T, qg, qb, qa, qab, p, singer, False, False)
+    k._add_process_noise(P, C_HAT, phi, T, qg, qb, qa, qab, p, singer, False, False, 1.0)
     w2 = phi @ phi / T**2
     c = C_HAT[2]
     assert P[:3, :3] @ c == pytest.approx((qg + 1e-4 * w2 * T) * c, rel=1e-12)
@@ -247,13 +247,19 @@ def test_add_process_noise_splits_tilt_and_heading(k, nx, singer):
     for unobserved, disturbed, hv in ((False, True, 0.0), (True, True, 1e-4)):
         Pd = np.zeros((nx, nx))
         k._add_process_noise(Pd, C_HAT, phi, T, qg, qb, qa, qab, p, singer, unobserved,
-                             disturbed)
+                             disturbed, 1.0)
         assert Pd[:3, :3] @ c == pytest.approx((qg + hv * w2 * T) * c, rel=1e-12, abs=1e-20)
         assert Pd[:3, :3] @ horiz == pytest.approx((qg + 1.6e-5 * w2 * T) * horiz, rel=1e-12)
     pb = _params_of(gyro_noise=2e-3, tilt_rate_noise=4e-3, heading_rate_noise=0.0)
     Pb = np.zeros((nx, nx))
-    k._add_process_noise(Pb, C_HAT, phi, T, qg, qb, qa, qab, pb, singer, True, True)
+    k._add_process_noise(Pb, C_HAT, phi, T, qg, qb, qa, qab, pb, singer, True, True, 1.0)
     assert Pb[:3, :3] @ c == pytest.approx((qg + 1.6e-5 * w2 * T) * c, rel=1e-12)
+    # the adaptation's factor m multiplies the tilt's rate noise only
+    Pm = np.zeros((nx, nx))
+    k._add_process_noise(Pm, C_HAT, phi, T, qg, qb, qa, qab, p, singer, False, False, 7.0)
+    assert Pm[:3, :3] @ c == pytest.approx((qg + 1e-4 * w2 * T) * c, rel=1e-12)
+    assert Pm[:3, :3] @ horiz == pytest.approx((qg + 7.0 * 1.6e-5 * w2 * T) * horiz,
+                                               rel=1e-12)
     diag = np.diag(P)
     assert np.all(diag[3:6] == qb)
     assert np.all(diag[6:9] == (qa if singer else (qab if nx == 9 else 0)))
@@ -261,6 +267,37 @@ def test_add_process_noise_splits_tilt_and_heading(k, nx, singer):
         assert np.all(diag[9:] == qab)
     assert np.count_nonzero(P - np.diag(diag) - np.pad(P[:3, :3] - np.diag(diag[:3]),
                                                       (0, nx - 3))) == 0
+
+
+def test_tilt_adapt_factor_is_one_below_the_level_then_proportional_and_capped(k):
+    """``m`` is 1 up to ``tilt_adapt_level``, the innovation power over the level above it,
+    at most ``tilt_adapt_max``; +∞ as the level never adapts."""
+    p = _params_of(tilt_adapt_level=5.0, tilt_adapt_max=25.0)
+    assert k._tilt_adapt(0.0, p) == 1.0
+    assert k._tilt_adapt(5.0, p) == 1.0
+    assert k._tilt_adapt(15.0, p) == pytest.approx(3.0, rel=1e-15)
+    assert k._tilt_adapt(1e6, p) == 25.0
+    assert k._tilt_adapt(1e300, _params_of(tilt_adapt_level=math.inf)) == 1.0
+
+
+@pytest.mark.parametrize("h", [0.002, 0.01, 0.04])
+def test_innovation_power_is_a_moving_mean_of_nis_per_second_whatever_the_rate(k, h):
+    """A constant innovation of power ``y²/density²`` (R = density²/T, P negligible) gives
+    NIS = T y²/density²: the moving mean of NIS/T reaches y²/density² at every sample rate,
+    after ``tilt_adapt_s`` to 1 − 1/e; NaN (no update) leaves it; an NIS above the gate
+    counts as the gate."""
+    p = _params_of(h=h, tilt_adapt_s=1.0)
+    power = 8.0  # 1/s
+    x, n = 0.0, round(1.0 / h)
+    for _ in range(n):
+        x = k._innovation_power(x, power * h, h, p)
+    assert x == pytest.approx(power * (1 - math.exp(-1.0)), rel=1e-9)
+    for _ in range(20 * n):
+        x = k._innovation_power(x, power * h, h, p)
+    assert x == pytest.approx(power, rel=1e-9)
+    assert k._innovation_power(x, math.nan, h, p) == x
+    big = k._innovation_power(0.0, 1e6, h, p)
+    assert big == pytest.approx(p.adapt_k * p.acc_gate_lowpass / h, rel=1e-12)
 
 
 # ------------------------------------------------------------------ 2, 4. rest

@@ -221,6 +221,23 @@ def test_a_still_start_shorter_than_the_window_equals_library(tmp_path, real):
     _equals_library(res, q, rc, fl, e.init_samples, real)
 
 
+def test_the_tilts_adapted_rate_noise_equals_library(tmp_path):
+    """On the suite's swinging 0.8 m pendulum the low-pass innovations' power exceeds
+    ``tilt_adapt_level`` for most of the record, so the tilt's rate noise grows
+    (``_kernel._tilt_adapt``, ``_innovation_power``): the library's output moves with the
+    adaptation switched off, and the C follows the library row by row, double to
+    ``DOUBLE_RAD`` with the same flags."""
+    t, gyro, acc, m, _truth = released_pendulum()
+    res = ekf(t, gyro, acc, m)
+    off = ekf(t, gyro, acc, m, config=AhrsConfig(tilt_adapt_level=math.inf))
+    assert np.abs(res.q - off.q).max() > 1e-4  # the adaptation acts on this record
+    h = check_rate_record(t, gyro, min_samples=4).td
+    e, lib = build(tmp_path, h=h, real="double", mag=True, algorithm="rate-single",
+                   config=AhrsConfig(), name="adapt_double")
+    q, rc, fl = run(e, lib, gyro, acc, m)
+    _equals_library(res, q, rc, fl, e.init_samples, "double")
+
+
 def rocking_start(n=4000, fs=100.0, seed=5, scale=1.018):
     """A record that starts in motion and never rests: rocking ±0.5 rad at 0.7 Hz about the
     body's x axis (about the sensor's point: the specific force is gravity's), its

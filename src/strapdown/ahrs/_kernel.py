@@ -240,6 +240,10 @@ class Params(NamedTuple):
     hi_update: float  #: how far it moves (a fraction of |b|) before it is applied again,
     hi_hold_s: float  #: how long they must hold, s,
     hi_min_spans: float  #: and the sums' weight (spans) they need
+    tilt_adapt_level: float  #: the innovation power (NIS per second) above which the tilt's
+    #: rate noise grows (:func:`_tilt_adapt`; +inf: never)
+    tilt_adapt_max: float  #: the largest factor on its variance
+    adapt_k: float  #: gain per epoch of the innovation power's moving mean (tilt_adapt_s)
 
 
 class Initial(NamedTuple):
@@ -725,11 +729,12 @@ def _propagate_covariance(P, phi, T, decay, singer, A, M):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _add_process_noise(P, C, phi, T, qg, qb, qa, qab, params, singer, unobserved, disturbed):
+def _add_process_noise(P, C, phi, T, qg, qb, qa, qab, params, singer, unobserved, disturbed,
+                       tilt_m):
     """Stage 3: ``P += Q``. The attitude gets the gyro's white noise and, for the gyro's
-    scale-factor and misalignment errors, ``tilt_rate_noise² |ω|² T`` on the two tilt
+    scale-factor and misalignment errors, ``m tilt_rate_noise² |ω|² T`` on the two tilt
     axes (horizontal in the reference frame: ``I − c cᵀ`` in the body frame with
-    c = C₃ᵀ, the vertical) and ``heading_rate_noise² |ω|² T`` on the heading (``c cᵀ``)
+    c = C₃ᵀ, the vertical; ``m``: ``tilt_m``, :func:`_tilt_adapt`'s factor) and ``heading_rate_noise² |ω|² T`` on the heading (``c cᵀ``)
     unless the last epoch found the field disturbed (``disturbed``): a fast rotation lets
     the accelerometer correct tilt sooner and the field correct the heading sooner, while
     a disturbed field, used de-weighted, does not gain weight with the rotation. ``unobserved`` (the
@@ -737,7 +742,7 @@ def _add_process_noise(P, C, phi, T, qg, qb, qa, qab, params, singer, unobserved
     takes at least the tilt's rate noise — the gyro's rate errors do not know which axis
     is vertical, and with no field they accumulate about the vertical unchecked."""
     w2 = (phi[0] ** 2 + phi[1] ** 2 + phi[2] ** 2) / T
-    qs = params.tilt_rate_noise ** 2 * w2
+    qs = tilt_m * params.tilt_rate_noise ** 2 * w2
     hr = max(params.tilt_rate_noise, params.heading_rate_noise) if unobserved else (
         0.0 if disturbed else params.heading_rate_noise)
     qv = hr ** 2 * w2 - qs
@@ -751,6 +756,34 @@ def _add_process_noise(P, C, phi, T, qg, qb, qa, qab, params, singer, unobserved
             P[6 + r, 6 + r] += qa
         if nx > (9 if singer else 6):
             P[nx - 3 + r, nx - 3 + r] += qab
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _tilt_adapt(nis_rate, params):
+    """Stage 3: the factor ``m`` on the tilt's rate noise (:func:`_add_process_noise`) —
+    1 while the low-pass accelerometer's innovations are as small as the model expects,
+    else their power ``nis_rate`` (:func:`_innovation_power`) over ``tilt_adapt_level``, at
+    most ``tilt_adapt_max``. Innovations persistently larger than the model allows mean
+    that the tilt is off by more than its covariance claims (the gyro's errors outgrew
+    ``tilt_rate_noise``: a scale error at a swing's rates, a clipped gyro); the grown
+    variance lets the accelerometer correct it (an innovation-based adaptive process
+    noise, Mohamed & Schwarz (1999))."""
+    if nis_rate <= params.tilt_adapt_level:
+        return 1.0
+    return min(nis_rate / params.tilt_adapt_level, params.tilt_adapt_max)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _innovation_power(nis_rate, nis, T, params):
+    """Stage 5, after the low-pass update (used or rejected; not when the measurement
+    is disturbed or waits): the moving mean, gain ``adapt_k`` per epoch (time constant
+    ``tilt_adapt_s``), of ``NIS / T``, each NIS counted at most as the gate
+    (``acc_gate_lowpass``: one outlier, a tap, does not count as a run of them). With
+    ``R = density² / T`` the NIS of an epoch is ``T`` times the innovation's power against
+    the density: ``NIS / T`` (1/s) does not change with the sample rate."""
+    if not nis >= 0.0:  # no NIS (NaN): nothing learned
+        return nis_rate
+    return nis_rate + params.adapt_k * (min(nis, params.acc_gate_lowpass) / T - nis_rate)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -1603,6 +1636,7 @@ def ekf_kernel(sensors, prop, window, params, init, out):
             lp2[a] = lp[a]
     rest_since = -1.0  # start of the current run of rest detections (−1: none)
     acc_bad_since = -1.0  # start of the current run of rejections (−1: none)
+    nis_rate = 0.0  # the low-pass innovations' power (_innovation_power)
     mag_bad_since = -1.0
     heading_unobserved = False  # the last epoch rejected a disturbed field (heading_bridge_noise)
     g_meas = params.gravity_measured  # gravity's norm as measured (or assumed, g_known false)
@@ -1644,7 +1678,7 @@ def ekf_kernel(sensors, prop, window, params, init, out):
         decay, qg, qb, qa, qab = _process_noise(T, params)
         _propagate_covariance(P, phi, T, decay, singer, A, M)
         _add_process_noise(P, C, phi, T, qg, qb, qa, qab, params, singer, heading_unobserved,
-                           mag_dist_prev)
+                           mag_dist_prev, _tilt_adapt(nis_rate, params))
         if params.gyro_scale_sigma > 0.0:
             _scale_floor(P, phi, T, params.gyro_scale_sigma, params.scale_k, w_slow)
         flags = 0
@@ -1711,6 +1745,7 @@ def ekf_kernel(sensors, prop, window, params, init, out):
                                                     params.acc_gate_lowpass, params.gating,
                                                     force, params.soft_gate, dx, U2, S2,
                                                     Si2)
+                    nis_rate = _innovation_power(nis_rate, nis_acc, T, params)
             else:
                 disturbed = not _acc_plausible(fk, params)
                 ok = False
