@@ -734,13 +734,14 @@ def _add_process_noise(P, C, phi, T, qg, qb, qa, qab, params, singer, unobserved
     """Stage 3: ``P += Q``. The attitude gets the gyro's white noise and, for the gyro's
     scale-factor and misalignment errors, ``m tilt_rate_noise² |ω|² T`` on the two tilt
     axes (horizontal in the reference frame: ``I − c cᵀ`` in the body frame with
-    c = C₃ᵀ, the vertical; ``m``: ``tilt_m``, :func:`_tilt_adapt`'s factor) and ``heading_rate_noise² |ω|² T`` on the heading (``c cᵀ``)
-    unless the last epoch found the field disturbed (``disturbed``): a fast rotation lets
-    the accelerometer correct tilt sooner and the field correct the heading sooner, while
-    a disturbed field, used de-weighted, does not gain weight with the rotation. ``unobserved`` (the
-    last epoch rejected a disturbed field, with ``heading_bridge_noise``): the heading
-    takes at least the tilt's rate noise — the gyro's rate errors do not know which axis
-    is vertical, and with no field they accumulate about the vertical unchecked."""
+    c = C₃ᵀ, the vertical; ``m``: ``tilt_m``, :func:`_tilt_adapt`'s factor) and
+    ``heading_rate_noise² |ω|² T`` on the heading (``c cᵀ``) unless the last epoch found
+    the field disturbed (``disturbed``): a fast rotation lets the accelerometer correct
+    tilt sooner and the field correct the heading sooner, while a disturbed field, used
+    de-weighted, does not gain weight with the rotation. ``unobserved`` (the last epoch
+    rejected a disturbed field, with ``heading_bridge_noise``): the heading takes at least
+    the tilt's rate noise — the gyro's rate errors do not know which axis is vertical, and
+    with no field they accumulate about the vertical unchecked."""
     w2 = (phi[0] ** 2 + phi[1] ** 2 + phi[2] ** 2) / T
     qs = tilt_m * params.tilt_rate_noise ** 2 * w2
     hr = max(params.tilt_rate_noise, params.heading_rate_noise) if unobserved else (
