@@ -327,6 +327,8 @@ def _entries() -> list[tuple[str, str, str, Callable[[Path], bytes | None]]]:
         ("npy_complex", "npy", "error", lambda p: npy_bytes(log.astype(complex))),
         ("npy_strings", "npy", "error", lambda p: npy_bytes(np.array([["a"] * 4] * 3))),
         ("npy_7tib", "npy", "error", lambda p: _npy_raw(big_hdr, bytes(64))),
+        ("npy_empty_but_unrepresentable", "npy", "error", lambda p: _npy_raw(
+            "{'descr': '<f8', 'fortran_order': False, 'shape': (0, 312, 3695261232714254), }")),
         ("npy_truncated", "npy", "error", lambda p: npy_bytes(log)[:-100]),
         ("npy_bad_version", "npy", "error", lambda p: b"\x93NUMPY\x09\x00" + bytes(64)),
         ("npy_huge_header_len", "npy", "error", lambda p: b"\x93NUMPY\x02\x00\xff\xff\xff\x7f"),
@@ -346,6 +348,10 @@ def _entries() -> list[tuple[str, str, str, Callable[[Path], bytes | None]]]:
             {"t": npy_bytes(t), "gyro": npy_bytes(w * 1e-3),
              "accel": npy_bytes(np.tile([0.0, 0.0, -9.81], (t.size, 1)))})),
         ("npz_empty", "npz", "error", lambda p: b""),
+        ("npz_empty_but_unrepresentable", "npz", "error", lambda p: _npz(
+            {"t": _npy_raw("{'descr': '<f8', 'fortran_order': False, "
+                           "'shape': (0, 312, 3695261232714254), }"),
+             "gyro": npy_bytes(w)}, zipfile.ZIP_STORED)),
         ("npz_broken_zip", "npz", "error", lambda p: _npz(
             {"t": npy_bytes(t), "gyro": npy_bytes(w)})[:-30]),
         ("npz_not_zip", "npz", "error", lambda p: b"PK\x03\x04 not really a zip" * 4),

@@ -18,6 +18,8 @@ EXPECTED = {
     "npy_valid": None, "npy_fortran": None, "npy_bigendian": None,
     "npy_empty": "an empty file .* expected an array saved by numpy.save",
     "npy_negative_shape": r"shape \(-5, 4\) has a negative dimension",
+    "npy_empty_but_unrepresentable": r"shape \(0, 312, 3695261232714254\) of float64 is "
+                                     "larger than any array can be",
     "npy_unclosed_header": "unreadable .npy header",
     "npy_structured": "structured dtype .* expected a plain numeric array",
     "npy_0d": r"must be \(n, 4\) \[t, gx, gy, gz\], got shape \(\)",
@@ -37,6 +39,8 @@ EXPECTED = {
     "npy_1e308": r"turns the body by 1e\+305 rad in one sample \(at most π\)",
     "npz_valid": None,
     "npz_empty": "an empty file; expected a .npz archive",
+    "npz_empty_but_unrepresentable": r"array 't'\): the .npy shape \(0, 312, 3695261232714254\) "
+                                     "of float64 is larger than any array can be",
     "npz_broken_zip": "not a readable .npz archive",
     "npz_not_zip": "not a readable .npz archive",
     "npz_encrypted": "is encrypted; numpy archives are not",

@@ -137,8 +137,13 @@ def read_npy_header(f: IO[bytes], where: object, what: str = "array") -> NpyHead
     if not isinstance(d, dict) or set(d) != {"descr", "fortran_order", "shape"}:
         raise InputError(f"{where}: the .npy header must be a dict of descr, fortran_order and "
                          f"shape, got {shown(d, 80)}")
-    return NpyHeader(_npy_dtype(where, what, d["descr"]), _npy_shape(where, d["shape"]),
-                     _npy_order(where, d["fortran_order"]), 8 + size_bytes + hlen)
+    dtype, shape = _npy_dtype(where, what, d["descr"]), _npy_shape(where, d["shape"])
+    # numpy refuses a shape whose nonzero dimensions overflow its index type, even when a
+    # zero dimension leaves the array empty: (0, 312, 3.7e15) is no array at all
+    if math.prod(max(n, 1) for n in shape) * dtype.itemsize > np.iinfo(np.intp).max:
+        raise InputError(f"{where}: the .npy shape {shown(shape, 60)} of {dtype.name} is "
+                         "larger than any array can be")
+    return NpyHeader(dtype, shape, _npy_order(where, d["fortran_order"]), 8 + size_bytes + hlen)
 
 
 def _npy_dtype(where: object, what: str, descr: object) -> np.dtype:
