@@ -398,6 +398,9 @@ def _entries() -> list[tuple[str, str, str, Callable[[Path], bytes | None]]]:
             [_mat_matrix("imu_gyr", w, dims=(64000, 3)), *_broad_vars()[1:]])),
         ("mat_negative_dims", "mat", "error", lambda p: mat_v5(
             [_mat_matrix("imu_gyr", w, dims=(-64, 3)), *_broad_vars()[1:]])),
+        ("mat_empty_but_unrepresentable", "mat", "error", lambda p: mat_v5(
+            [_mat_matrix("imu_gyr", dims=(0, 2**31 - 1, 2**31 - 1, 2**31 - 1), data=b""),
+             *_broad_vars()[1:]])),
         ("mat_v4", "mat", "error", _v4),
         ("mat_v73_valid", "mat", "ok", lambda p: _v73(
             p, {"imu_gyr": w.T, "sampling_rate": np.array([[1000.0]])})),

@@ -67,6 +67,8 @@ EXPECTED = {
     "mat_char": "variable 'imu_gyr' is a char array",
     "mat_dims_lie": "declares 64000x3 values, its data holds 192: the file is corrupt",
     "mat_negative_dims": "negative dimensions",
+    "mat_empty_but_unrepresentable": r"variable 'imu_gyr' has dimensions \(0, 2147483647, "
+                                     r"2147483647, 2147483647\), larger than any array can be",
     "mat_v4": r"MAT v4 file; re-save it in MATLAB with save\(file, '-v7'\)",
     "mat_v73_char": "variable 'imu_gyr' is a MATLAB char",
     "mat_bomb": "a compressed variable would inflate .* a compression bomb",

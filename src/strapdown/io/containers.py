@@ -138,12 +138,18 @@ def read_npy_header(f: IO[bytes], where: object, what: str = "array") -> NpyHead
         raise InputError(f"{where}: the .npy header must be a dict of descr, fortran_order and "
                          f"shape, got {shown(d, 80)}")
     dtype, shape = _npy_dtype(where, what, d["descr"]), _npy_shape(where, d["shape"])
-    # numpy refuses a shape whose nonzero dimensions overflow its index type, even when a
-    # zero dimension leaves the array empty: (0, 312, 3.7e15) is no array at all
-    if math.prod(max(n, 1) for n in shape) * dtype.itemsize > np.iinfo(np.intp).max:
+    if not _representable(shape, dtype):
         raise InputError(f"{where}: the .npy shape {shown(shape, 60)} of {dtype.name} is "
                          "larger than any array can be")
     return NpyHeader(dtype, shape, _npy_order(where, d["fortran_order"]), 8 + size_bytes + hlen)
+
+
+def _representable(shape: tuple[int, ...], dtype: np.dtype) -> bool:
+    """Whether numpy can make an array of ``shape`` (non-negative) and ``dtype``: it refuses
+    one whose nonzero dimensions overflow its index type even when a zero dimension leaves
+    it empty — (0, 312, 3.7e15) is no array at all (a .npy header, a MAT-file's
+    dimensions)."""
+    return math.prod(max(n, 1) for n in shape) * dtype.itemsize <= np.iinfo(np.intp).max
 
 
 def _npy_dtype(where: object, what: str, descr: object) -> np.dtype:
@@ -372,6 +378,9 @@ def _mat_matrix(s, e: str, where: object, wanted: set[str]
     check_bytes(where, count * 8, what)
     t, data = _mat_sub(s, e, where, tuple(_MI), f"data of {what}")
     dt = np.dtype(e + _MI[t])
+    if not _representable(dims, dt):
+        raise InputError(f"{where}: {what} has dimensions {dims}, larger than any array can "
+                         "be: the file is corrupt")
     if len(data) != count * dt.itemsize:
         raise InputError(f"{where}: {what} declares {'x'.join(map(str, dims))} values, its data "
                          f"holds {len(data) // dt.itemsize}: the file is corrupt")
