@@ -80,7 +80,7 @@ import numpy as np
 from strapdown._core.validation import as_quaternions
 from strapdown.ahrs import _kernel as K
 from strapdown.ahrs.flags import MeasurementFlag
-from strapdown.ahrs.saturation import warn_if_saturated
+from strapdown.ahrs.saturation import clipped, warn_if_saturated
 from strapdown.rotation.quaternion import quat_from_rotvec, quat_multiply
 
 __all__ = ["AccelerometerUnusedWarning", "AhrsConfig", "AhrsResult", "attitude_from_acc_mag",
@@ -393,6 +393,21 @@ class AhrsConfig:
         too): RepoIMU's pendulum 1.054× → 1.003× offlineVQF, its T-stick 1.46× → 1.34×
         (a gyro clipped at 7.4 rad/s), BROAD unchanged (docs/reproductions.md, "Where the
         passes contradict each other"). ``math.inf`` switches it off.
+    offline_clip_s : float
+        Where the gyro is clipped at its range (:func:`strapdown.ahrs.saturation.gyro_plateaus`
+        finds an axis: :class:`~strapdown.ahrs.saturation.GyroSaturationWarning`), both of
+        :func:`offline_ekf`'s passes carry the missed rotation on — the forward pass after
+        each clip, the backward pass before it — and their combination is wrong on both
+        sides even where their tilts do not yet contradict each other. Within this many
+        seconds of every clipped sample (:func:`~strapdown.ahrs.saturation.clipped`) the
+        tilt is taken from the accelerometer directly, as where the passes contradict each
+        other (``offline_consistency_gate``, ``_direct_tilt``). Default 2.1 s, one
+        ``acc_lowpass_s``: the span of the direct tilt's own low-pass (1 and 3 s measured
+        within 0.02× of it); 0 switches it off. Nothing changes where no axis is found
+        clipped: BROAD, OpenAXES, the suite and RepoIMU's pendulum. RepoIMU's T-stick
+        (clipped at 7.4 rad/s in its tests 05 and 10) 1.34× → 0.97× offlineVQF, chosen
+        there; held out, the suite's 0.3 m pendulum read by a gyro clipped at 60 % of its
+        peak rate 1.31× → 0.98× (docs/reproductions.md, "A gyro past its range, offline").
     hard_iron_s : float
         :func:`ekf` estimates the magnetometer's hard-iron offset online, the causal form of
         :func:`strapdown.ahrs.hard_iron.hard_iron` (``_kernel._hard_iron_span``): every
@@ -641,6 +656,7 @@ class AhrsConfig:
     offline_lowpass_wait: float = 2.0
     offline_hard_iron_min_explained: float = 0.3
     offline_consistency_gate: float = 50.0
+    offline_clip_s: float = 2.1
     hard_iron_s: float = 30.0
     hard_iron_hold_s: float = 5.0
     hard_iron_min_explained: float = 0.3
@@ -723,7 +739,7 @@ _MAY_BE_INFINITE = ("mag_reject_s", "offline_mag_reject_s", "moving_start_headin
 _ANY_SIGN = ("declination_deg",)
 _NON_NEGATIVE = ("lever_arm", "acc_motion_leak", "tilt_rate_noise", "heading_rate_noise",
                  "gyro_scale_sigma", "offline_heading_rate_noise", "offline_smooth_s",
-                 "offline_lowpass_wait",
+                 "offline_lowpass_wait", "offline_clip_s",
                  "mag_reject_s", "rest_min_s", "mag_delay_s", "latency_s", "mag_delay_max_s",
                  "mag_disturbed_power", "offline_mag_reject_s", "mag_delay_z", "hard_iron_s",
                  "hard_iron_hold_s", "hard_iron_min_explained", "acc_scale_tol")
@@ -1567,10 +1583,11 @@ def _zero_phase_sos(tau: float, rec):
     return butter(2, fc, fs=1.0 / rec.td, output="sos")
 
 
-def _direct_tilt(rec, acc, out: K.Outputs, tilt_nis: np.ndarray, cfg: AhrsConfig) -> None:
-    """In place on the smoothed combination (at the stamps): where the two passes' tilts
-    contradict each other (``tilt_nis`` from :func:`_combine` above
-    ``offline_consistency_gate``), the tilt is the accelerometer's, taken directly — the
+def _direct_tilt(rec, acc, out: K.Outputs, bad: np.ndarray, cfg: AhrsConfig) -> None:
+    """In place on the smoothed combination (at the stamps): where the passes' model of the
+    gyro broke (``bad``: their tilts contradict each other — ``tilt_nis`` from
+    :func:`_combine` above ``offline_consistency_gate`` — or a clipped gyro is near,
+    :func:`_near_clip`), the tilt is the accelerometer's, taken directly — the
     specific force turned into the bias-corrected gyro's own path (:func:`_kernel.gyro_path`,
     the combined bias), low-passed forward and backward (second-order Butterworth of time
     constant ``acc_lowpass_s``, zero phase) and that direction taken as up, the structure
@@ -1582,7 +1599,6 @@ def _direct_tilt(rec, acc, out: K.Outputs, tilt_nis: np.ndarray, cfg: AhrsConfig
     from strapdown.rotation.quaternion import quat_conjugate, quat_rotate, rotvec_from_quat
 
     n = rec.t.size
-    bad = tilt_nis > cfg.offline_consistency_gate
     sos = _zero_phase_sos(cfg.acc_lowpass_s, rec) if bad.any() else None
     if sos is None:
         return
@@ -1610,6 +1626,19 @@ def _direct_tilt(rec, acc, out: K.Outputs, tilt_nis: np.ndarray, cfg: AhrsConfig
     out.q[:] = quat_multiply(out.q, quat_from_rotvec(weight[:, None] * step))
 
 
+def _near_clip(rec, saturated, cfg: AhrsConfig) -> np.ndarray:
+    """The samples within ``offline_clip_s`` of a clipped one
+    (:func:`~strapdown.ahrs.saturation.clipped` on the axes ``saturated`` found); all False
+    when none is or the window is 0."""
+    near = clipped(rec.omega, saturated)
+    if cfg.offline_clip_s <= 0.0 or not near.any():
+        return np.zeros_like(near)
+    w = round(cfg.offline_clip_s / rec.td)
+    n = near.size
+    count = np.concatenate(([0], np.cumsum(near)))
+    k = np.arange(n)
+    return count[np.minimum(k + w + 1, n)] > count[np.maximum(k - w, 0)]
+
 def offline_ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
                 config: AhrsConfig | None = None, q0=None, gyro_bias0=None,
                 mag_reference=None, frame: str = "ENU") -> AhrsResult:
@@ -1634,7 +1663,9 @@ def offline_ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
     motion, never measured gravity's norm, that still end measures it for the backward pass,
     as a still start does); last, what
     of the combination varies faster than ``offline_smooth_s`` about the bias-corrected
-    gyro's own path is removed (zero-phase; :class:`AhrsConfig`). Before the passes, a
+    gyro's own path is removed (zero-phase; :class:`AhrsConfig`), and where the passes' tilts
+    contradict each other (``offline_consistency_gate``) or a clipped gyro is near
+    (``offline_clip_s``) the tilt is the accelerometer's, taken directly. Before the passes, a
     hard-iron offset of the magnetometer found from the gyro over the whole record is
     subtracted when the tests of ``offline_hard_iron_min_explained`` pass
     (:mod:`strapdown.ahrs.hard_iron`; ``AhrsResult.mag_offset``); the passes run without
@@ -1649,7 +1680,7 @@ def offline_ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
     """
     cfg = config or AhrsConfig()
     rec, acc, mag, have_mag = _validate(t, gyro, acc, mag, cfg, frame)
-    warn_if_saturated(rec.omega, "offline_ekf")
+    saturated = warn_if_saturated(rec.omega, "offline_ekf")
     offset = _hard_iron_offset(rec, mag, have_mag, cfg)
     if offset is not None:
         mag = mag - offset
@@ -1684,7 +1715,8 @@ def offline_ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
     tilt_nis = _combine(fwd, bwd)
     _gyro_smooth(rec, fwd, cfg)
     if cfg.use_accelerometer:
-        _direct_tilt(rec, acc, fwd, tilt_nis, cfg)
+        broken = (tilt_nis > cfg.offline_consistency_gate) | _near_clip(rec, saturated, cfg)
+        _direct_tilt(rec, acc, fwd, broken, cfg)
     result = replace(_result(rec, fwd, epoch, frame, have_mag, algorithm, cfg, start,
                              smoothed=True), mag_offset=offset)
     _warn_if_accelerometer_unused(result, acc, gravity, cfg, "offline_ekf")

@@ -6,7 +6,9 @@ plateau, until the accelerometer and the magnetometer pull it back. RepoIMU's T-
 samples, and every filter is tens of degrees off there (docs/reproductions.md, "RepoIMU's
 T-stick"). :func:`gyro_plateaus` finds the signature in a record and :func:`ekf
 <strapdown.ahrs.ekf>` and :func:`offline_ekf <strapdown.ahrs.offline_ekf>` warn with it
-(:class:`GyroSaturationWarning`); the estimates do not change.
+(:class:`GyroSaturationWarning`). The causal estimate does not change; :func:`offline_ekf
+<strapdown.ahrs.offline_ekf>` takes its tilt from the accelerometer around the clipped samples
+(:func:`clipped`, ``AhrsConfig.offline_clip_s``).
 
 The signature, per axis: plateaus near the axis's largest rate — at least :data:`MIN_RUN`
 samples whose rate changes by no more than :data:`FLAT` of itself per sample — each entered
@@ -33,7 +35,7 @@ from numpy.typing import ArrayLike
 from strapdown.ahrs import _kernel as K
 
 __all__ = ["FLAT", "MIN_LEVEL", "MIN_RUN", "MIN_RUNS", "NEAR", "STEP", "GyroSaturationWarning",
-           "Plateaus", "gyro_plateaus", "warn_if_saturated"]
+           "Plateaus", "clipped", "gyro_plateaus", "warn_if_saturated"]
 
 #: Largest change per sample, relative to the rate, within a plateau.
 FLAT = 0.002
@@ -81,6 +83,17 @@ def gyro_plateaus(omega: ArrayLike) -> list[Plateaus]:
     K.gyro_plateau_runs(w, NEAR, FLAT, STEP, MIN_RUN, runs, samples, level)
     return [Plateaus(a, int(runs[a]), float(level[a]), int(samples[a])) for a in range(3)
             if runs[a] >= MIN_RUNS and level[a] >= MIN_LEVEL]
+
+
+def clipped(omega: ArrayLike, found: list[Plateaus]) -> np.ndarray:
+    """The samples of ``omega`` (rad/s, shape (n, 3)) at a clipped axis's range: on an axis
+    of ``found`` (:func:`gyro_plateaus`), a rate within :data:`STEP` of its plateaus' level
+    or beyond it. Boolean, shape (n,); all False when ``found`` is empty."""
+    w = np.asarray(omega, dtype=np.float64)
+    out = np.zeros(w.shape[0], dtype=bool)
+    for p in found:
+        out |= np.abs(w[:, p.axis]) >= (1.0 - STEP) * p.level
+    return out
 
 
 def warn_if_saturated(omega: ArrayLike, where: str) -> list[Plateaus]:
