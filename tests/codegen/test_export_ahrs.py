@@ -7,6 +7,8 @@ from __future__ import annotations
 
 import math
 import re
+import warnings
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -14,14 +16,14 @@ import pytest
 from ahrs_harness import Stream, angle, build, run
 
 from conftest import BROAD
-from strapdown.ahrs import AhrsConfig, ekf
+from strapdown.ahrs import AhrsConfig, GyroSaturationWarning, ekf
 from strapdown.ahrs import _kernel as K
 from strapdown.algorithms.rate import check_rate_record
 from strapdown.codegen.ahrs_c import generate_ahrs
 from strapdown.rotation.dcm import dcm_from_quat
 from strapdown.rotation.quaternion import quat_from_rotvec
 from strapdown.truth.motions import SpinConing
-from suite_records import released_pendulum
+from suite_records import clipped_pendulum, released_pendulum
 
 TEMPLATE = Path(K.__file__).parents[1] / "codegen" / "templates" / "ahrs.c.in"
 WAIT, ERR_INPUT, ERR_NUMERIC = 1, -1, -3
@@ -234,6 +236,27 @@ def test_the_tilts_adapted_rate_noise_equals_library(tmp_path):
     h = check_rate_record(t, gyro, min_samples=4).td
     e, lib = build(tmp_path, h=h, real="double", mag=True, algorithm="rate-single",
                    config=AhrsConfig(), name="adapt_double")
+    q, rc, fl = run(e, lib, gyro, acc, m)
+    _equals_library(res, q, rc, fl, e.init_samples, "double")
+
+
+def test_the_clipped_gyros_suspended_norm_test_equals_library(tmp_path):
+    """A gyro clipped at its range, given as ``gyro_range`` (the C export cannot find it
+    from a record): within ``gyro_clip_s`` of a clipped sample the low-pass model's norm
+    test is suspended (``_kernel._fold_clip_samples``). On the suite's 0.3 m pendulum
+    clipped at 60 % of its peak rate the rule acts (the library's output moves without
+    it), and the C follows the library row by row, double to ``DOUBLE_RAD`` with the same
+    flags."""
+    t, gyro, acc, m, _truth, level = clipped_pendulum(duration_s=20.0)
+    cfg = AhrsConfig(gyro_range=level)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", GyroSaturationWarning)
+        res = ekf(t, gyro, acc, m, config=cfg)
+        off = ekf(t, gyro, acc, m, config=replace(cfg, gyro_clip_s=0.0))
+    assert np.abs(res.q - off.q).max() > 1e-2  # the rule acts on this record
+    h = check_rate_record(t, gyro, min_samples=4).td
+    e, lib = build(tmp_path, h=h, real="double", mag=True, algorithm="rate-single",
+                   config=cfg, name="clip_double")
     q, rc, fl = run(e, lib, gyro, acc, m)
     _equals_library(res, q, rc, fl, e.init_samples, "double")
 

@@ -244,6 +244,8 @@ class Params(NamedTuple):
     #: rate noise grows (:func:`_tilt_adapt`; +inf: never)
     tilt_adapt_max: float  #: the largest factor on its variance
     adapt_k: float  #: gain per epoch of the innovation power's moving mean (tilt_adapt_s)
+    clip_level: float  #: the gyro's range, rad/s (0: none known; AhrsConfig.gyro_range)
+    clip_s: float  #: how long after a sample at it the norm test is suspended (gyro_clip_s)
 
 
 class Initial(NamedTuple):
@@ -639,6 +641,10 @@ def _window_step(e, x, h, prop, offsets, weights, pi, pj, pc, ring, q, bias, phi
     return b + prop.end_off, prop.stride * h
 
 
+#: A rate at this fraction of the gyro's range or beyond is taken as clipped: a clipped
+#: gyro's plateaus are flat to 0.2 % (:mod:`strapdown.ahrs.saturation`).
+CLIP_NEAR = 0.98
+
 @njit(cache=True, inline="always", error_model="numpy")
 def _rate_at(k, x, h, is_rate, a):
     """The gyro's rate of sample k about axis a, rad/s, bias not removed: ``x[k]`` for
@@ -662,6 +668,21 @@ def _fold_rest_samples(last, k, ema_n, rest_alpha, x, acc, h, is_rate, gm, g2, a
             am[a] += al * (acc[last, a] - am[a])
             a2[a] += al * (acc[last, a] * acc[last, a] - a2[a])
     return last, ema_n
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _fold_clip_samples(last, k, x, h, is_rate, params, last_clip):
+    """Stage 2: the time of the latest of samples last + 1 … k whose rate reaches the
+    gyro's range on an axis (:data:`CLIP_NEAR` of ``clip_level`` or beyond), else
+    ``last_clip``."""
+    if params.clip_level > 0.0:
+        j = last
+        while j < k:
+            j += 1
+            for a in range(3):
+                if abs(_rate_at(j, x, h, is_rate, a)) >= CLIP_NEAR * params.clip_level:
+                    last_clip = j * h
+    return last_clip
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -1549,6 +1570,7 @@ def ekf_kernel(sensors, prop, window, params, init, out):
     rest_alpha = h / params.rest_tau
     ema_n = 0.0
     last = 0  # last sample folded into the rest detector
+    last_clip = -np.inf  # the time of the last sample at the gyro's range
     # measurement work: C_n_b, the epoch's error-state correction, bias-corrected
     # specific force (body, reference frame), its low-pass and the low-pass states, the
     # field in the reference frame, H, R, y and the update work arrays
@@ -1673,6 +1695,7 @@ def ekf_kernel(sensors, prop, window, params, init, out):
                 for a in range(3):
                     phi[a] = phi[a] / lag  # per-epoch rotation for the covariance
         # stages 2, 3: rest detector, covariance
+        last_clip = _fold_clip_samples(last, k, x, h, is_rate, params, last_clip)
         last, ema_n = _fold_rest_samples(last, k, ema_n, rest_alpha, x, acc, h, is_rate,
                                          gm, g2, am, a2)
         _dcm(q, C)
@@ -1725,8 +1748,11 @@ def ekf_kernel(sensors, prop, window, params, init, out):
                         g_learn, n_learn, g_meas = _learn_gravity(lp, params, g_learn,
                                                                   n_learn)
                 # a sustained acceleration (a coordinated turn) does not average out: the
-                # low-passed specific force is then longer than gravity
-                disturbed = params.gating and not _lowpass_plausible(lp, params, g_meas)
+                # low-passed specific force is then longer than gravity — unless the gyro
+                # was clipped within clip_s: the attitude then misses the rotation beyond
+                # its range, and the low-pass mixes specific forces turned by two attitudes
+                disturbed = (params.gating and not _lowpass_plausible(lp, params, g_meas)
+                             and not tk - last_clip < params.clip_s)
                 ok = False
                 # lp_settle = 0: no update while the low-pass is still averaging its first
                 # lp_init_n epochs unless the accelerometer is quiet (a running mean of a

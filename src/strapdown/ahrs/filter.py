@@ -80,7 +80,7 @@ import numpy as np
 from strapdown._core.validation import as_quaternions
 from strapdown.ahrs import _kernel as K
 from strapdown.ahrs.flags import MeasurementFlag
-from strapdown.ahrs.saturation import clipped, warn_if_saturated
+from strapdown.ahrs.saturation import clipped, gyro_range, warn_if_saturated
 from strapdown.rotation.quaternion import quat_from_rotvec, quat_multiply
 
 __all__ = ["AccelerometerUnusedWarning", "AhrsConfig", "AhrsResult", "attitude_from_acc_mag",
@@ -393,21 +393,37 @@ class AhrsConfig:
         too): RepoIMU's pendulum 1.054× → 1.003× offlineVQF, its T-stick 1.46× → 1.34×
         (a gyro clipped at 7.4 rad/s), BROAD unchanged (docs/reproductions.md, "Where the
         passes contradict each other"). ``math.inf`` switches it off.
-    offline_clip_s : float
-        Where the gyro is clipped at its range (:func:`strapdown.ahrs.saturation.gyro_plateaus`
-        finds an axis: :class:`~strapdown.ahrs.saturation.GyroSaturationWarning`), both of
-        :func:`offline_ekf`'s passes carry the missed rotation on — the forward pass after
-        each clip, the backward pass before it — and their combination is wrong on both
-        sides even where their tilts do not yet contradict each other. Within this many
-        seconds of every clipped sample (:func:`~strapdown.ahrs.saturation.clipped`) the
-        tilt is taken from the accelerometer directly, as where the passes contradict each
-        other (``offline_consistency_gate``, ``_direct_tilt``). Default 2.1 s, one
-        ``acc_lowpass_s``: the span of the direct tilt's own low-pass (1 and 3 s measured
-        within 0.02× of it); 0 switches it off. Nothing changes where no axis is found
-        clipped: BROAD, OpenAXES, the suite and RepoIMU's pendulum. RepoIMU's T-stick
-        (clipped at 7.4 rad/s in its tests 05 and 10) 1.34× → 0.97× offlineVQF, chosen
-        there; held out, the suite's 0.3 m pendulum read by a gyro clipped at 60 % of its
-        peak rate 1.31× → 0.98× (docs/reproductions.md, "A gyro past its range, offline").
+    gyro_range : float
+        The gyro's range (full scale), rad/s, on every axis: a rate at 0.98 of it or beyond
+        is taken as clipped (:func:`strapdown.ahrs.saturation.clipped`). Default 0: found
+        from the record — the lowest level of the axes whose plateaus
+        :func:`~strapdown.ahrs.saturation.gyro_plateaus` finds
+        (:class:`~strapdown.ahrs.saturation.GyroSaturationWarning`), none when it finds
+        none; a range is a property of the sensor, so taking it from the whole record does
+        not make :func:`ekf` acausal (the C export takes it as given, ``gyro_range`` of
+        the config it is generated from). ``math.inf``: never clipped.
+    gyro_clip_s : float
+        Near a clipped gyro sample the attitude misses the rotation beyond the range, and
+        both filters distrust what the gyro carried there. :func:`ekf` (and the C export)
+        does not apply the low-pass accelerometer's norm test (``acc_lowpass_norm_tol``)
+        for this many seconds after a clipped sample: the low-pass then mixes specific
+        forces turned by two attitudes and its norm departs from gravity's without any
+        sustained acceleration — it called the accelerometer disturbed and left the tilt
+        on the gyro alone for as long as that lasted (RepoIMU's T-stick, test 05: for most
+        of each trial). :func:`offline_ekf` takes its tilt from the accelerometer directly
+        within this many seconds of every clipped sample, as where its passes contradict
+        each other (``offline_consistency_gate``, ``_direct_tilt``): both passes carry the
+        missed rotation on — the forward pass after each clip, the backward pass before
+        it — so their combination is wrong on both sides before their tilts contradict.
+        Default 2.1 s, one ``acc_lowpass_s``, the low-pass's own span (1 and 3 s offline,
+        5 s causal, measured within 0.02×); 0 switches both off. Nothing changes where no
+        range is known or reached: BROAD, OpenAXES, the suite and RepoIMU's pendulum.
+        RepoIMU's T-stick (clipped at 7.4 rad/s in its tests 05 and 10), chosen there:
+        causal 1.11× → 1.03× VQF, offline 1.34× → 1.06× offlineVQF (0.99× without test
+        05, where every filter is lost); held out, the suite's 0.3 m pendulum read by a
+        gyro clipped at 60 % / 80 % of its peak rate: causal 1.35× / 1.75× → 1.02× /
+        1.05× VQF, offline 1.31× / 1.26× → 1.00× / 1.03× (docs/reproductions.md, "A gyro
+        past its range").
     hard_iron_s : float
         :func:`ekf` estimates the magnetometer's hard-iron offset online, the causal form of
         :func:`strapdown.ahrs.hard_iron.hard_iron` (``_kernel._hard_iron_span``): every
@@ -656,7 +672,8 @@ class AhrsConfig:
     offline_lowpass_wait: float = 2.0
     offline_hard_iron_min_explained: float = 0.3
     offline_consistency_gate: float = 50.0
-    offline_clip_s: float = 2.1
+    gyro_range: float = 0.0
+    gyro_clip_s: float = 2.1
     hard_iron_s: float = 30.0
     hard_iron_hold_s: float = 5.0
     hard_iron_min_explained: float = 0.3
@@ -735,11 +752,11 @@ class AhrsConfig:
 
 #: AhrsConfig fields that may be +∞, negative, or zero.
 _MAY_BE_INFINITE = ("mag_reject_s", "offline_mag_reject_s", "moving_start_heading_s",
-                    "offline_consistency_gate", "tilt_adapt_level")
+                    "offline_consistency_gate", "tilt_adapt_level", "gyro_range")
 _ANY_SIGN = ("declination_deg",)
 _NON_NEGATIVE = ("lever_arm", "acc_motion_leak", "tilt_rate_noise", "heading_rate_noise",
                  "gyro_scale_sigma", "offline_heading_rate_noise", "offline_smooth_s",
-                 "offline_lowpass_wait", "offline_clip_s",
+                 "offline_lowpass_wait", "gyro_range", "gyro_clip_s",
                  "mag_reject_s", "rest_min_s", "mag_delay_s", "latency_s", "mag_delay_max_s",
                  "mag_disturbed_power", "offline_mag_reject_s", "mag_delay_z", "hard_iron_s",
                  "hard_iron_hold_s", "hard_iron_min_explained", "acc_scale_tol")
@@ -1103,6 +1120,8 @@ def _derived(cfg: AhrsConfig, ref, use_mag: bool, h: float, te: float,
             "mag_ref_k": 1.0 - math.exp(-te / cfg.mag_reference_s),
             "scale_k": 1.0 - math.exp(-te / cfg.gyro_scale_tau),
             "adapt_k": 1.0 - math.exp(-te / cfg.tilt_adapt_s),
+            "clip_level": cfg.gyro_range if cfg.gyro_range < math.inf else 0.0,
+            "clip_s": cfg.gyro_clip_s,
             "mag_delay": round(cfg.mag_delay_s / h),
             "mag_delay_max": max(round(cfg.mag_delay_max_s / h), round(cfg.mag_delay_s / h)),
             "mag_delay_alpha": min(1.0, h / cfg.mag_delay_tau_s), "store_covariance": False,
@@ -1421,7 +1440,7 @@ def ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
     cfg = config or AhrsConfig()
     rec, acc, mag, have_mag, q_init, b0, ref, start = _setup(t, gyro, acc, mag, cfg, q0,
                                                               gyro_bias0, mag_reference, frame)
-    warn_if_saturated(rec.omega, "ekf")
+    cfg = _with_range(cfg, warn_if_saturated(rec.omega, "ekf"))
     out, epoch, gravity, offset, _ = _filter(rec, acc, mag, have_mag, cfg, algorithm, q_init,
                                              b0, ref, start)
     result = replace(_result(rec, out, epoch, frame, have_mag, algorithm, cfg, start),
@@ -1626,14 +1645,23 @@ def _direct_tilt(rec, acc, out: K.Outputs, bad: np.ndarray, cfg: AhrsConfig) -> 
     out.q[:] = quat_multiply(out.q, quat_from_rotvec(weight[:, None] * step))
 
 
-def _near_clip(rec, saturated, cfg: AhrsConfig) -> np.ndarray:
-    """The samples within ``offline_clip_s`` of a clipped one
-    (:func:`~strapdown.ahrs.saturation.clipped` on the axes ``saturated`` found); all False
-    when none is or the window is 0."""
-    near = clipped(rec.omega, saturated)
-    if cfg.offline_clip_s <= 0.0 or not near.any():
+def _with_range(cfg: AhrsConfig, found) -> AhrsConfig:
+    """``cfg`` with ``gyro_range`` 0 (found from the record) replaced by the range the gyro
+    is found clipped at (:func:`~strapdown.ahrs.saturation.gyro_range` of ``found``), or
+    by ``math.inf`` (none) when it is not."""
+    if cfg.gyro_range != 0.0:
+        return cfg
+    return replace(cfg, gyro_range=gyro_range(found) or math.inf)
+
+
+def _near_clip(rec, cfg: AhrsConfig) -> np.ndarray:
+    """The samples within ``gyro_clip_s`` of one at the gyro's range (``gyro_range``,
+    resolved by :func:`_with_range`; :func:`~strapdown.ahrs.saturation.clipped`); all
+    False when none is or the window is 0."""
+    near = clipped(rec.omega, cfg.gyro_range)
+    if cfg.gyro_clip_s <= 0.0 or not near.any():
         return np.zeros_like(near)
-    w = round(cfg.offline_clip_s / rec.td)
+    w = round(cfg.gyro_clip_s / rec.td)
     n = near.size
     count = np.concatenate(([0], np.cumsum(near)))
     k = np.arange(n)
@@ -1665,7 +1693,7 @@ def offline_ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
     of the combination varies faster than ``offline_smooth_s`` about the bias-corrected
     gyro's own path is removed (zero-phase; :class:`AhrsConfig`), and where the passes' tilts
     contradict each other (``offline_consistency_gate``) or a clipped gyro is near
-    (``offline_clip_s``) the tilt is the accelerometer's, taken directly. Before the passes, a
+    (``gyro_clip_s``) the tilt is the accelerometer's, taken directly. Before the passes, a
     hard-iron offset of the magnetometer found from the gyro over the whole record is
     subtracted when the tests of ``offline_hard_iron_min_explained`` pass
     (:mod:`strapdown.ahrs.hard_iron`; ``AhrsResult.mag_offset``); the passes run without
@@ -1680,7 +1708,7 @@ def offline_ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
     """
     cfg = config or AhrsConfig()
     rec, acc, mag, have_mag = _validate(t, gyro, acc, mag, cfg, frame)
-    saturated = warn_if_saturated(rec.omega, "offline_ekf")
+    cfg = _with_range(cfg, warn_if_saturated(rec.omega, "offline_ekf"))
     offset = _hard_iron_offset(rec, mag, have_mag, cfg)
     if offset is not None:
         mag = mag - offset
@@ -1715,7 +1743,7 @@ def offline_ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
     tilt_nis = _combine(fwd, bwd)
     _gyro_smooth(rec, fwd, cfg)
     if cfg.use_accelerometer:
-        broken = (tilt_nis > cfg.offline_consistency_gate) | _near_clip(rec, saturated, cfg)
+        broken = (tilt_nis > cfg.offline_consistency_gate) | _near_clip(rec, cfg)
         _direct_tilt(rec, acc, fwd, broken, cfg)
     result = replace(_result(rec, fwd, epoch, frame, have_mag, algorithm, cfg, start,
                              smoothed=True), mag_offset=offset)

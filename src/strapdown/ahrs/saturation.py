@@ -6,9 +6,10 @@ plateau, until the accelerometer and the magnetometer pull it back. RepoIMU's T-
 samples, and every filter is tens of degrees off there (docs/reproductions.md, "RepoIMU's
 T-stick"). :func:`gyro_plateaus` finds the signature in a record and :func:`ekf
 <strapdown.ahrs.ekf>` and :func:`offline_ekf <strapdown.ahrs.offline_ekf>` warn with it
-(:class:`GyroSaturationWarning`). The causal estimate does not change; :func:`offline_ekf
-<strapdown.ahrs.offline_ekf>` takes its tilt from the accelerometer around the clipped samples
-(:func:`clipped`, ``AhrsConfig.offline_clip_s``).
+(:class:`GyroSaturationWarning`), and near a clipped sample (:func:`clipped`, at the range
+:func:`gyro_range` or ``AhrsConfig.gyro_range``) both distrust the attitude the gyro carried:
+``ekf`` suspends its low-pass accelerometer's norm test, ``offline_ekf`` takes its tilt from
+the accelerometer directly (``AhrsConfig.gyro_clip_s``).
 
 The signature, per axis: plateaus near the axis's largest rate — at least :data:`MIN_RUN`
 samples whose rate changes by no more than :data:`FLAT` of itself per sample — each entered
@@ -35,7 +36,7 @@ from numpy.typing import ArrayLike
 from strapdown.ahrs import _kernel as K
 
 __all__ = ["FLAT", "MIN_LEVEL", "MIN_RUN", "MIN_RUNS", "NEAR", "STEP", "GyroSaturationWarning",
-           "Plateaus", "clipped", "gyro_plateaus", "warn_if_saturated"]
+           "Plateaus", "clipped", "gyro_plateaus", "gyro_range", "warn_if_saturated"]
 
 #: Largest change per sample, relative to the rate, within a plateau.
 FLAT = 0.002
@@ -85,15 +86,22 @@ def gyro_plateaus(omega: ArrayLike) -> list[Plateaus]:
             if runs[a] >= MIN_RUNS and level[a] >= MIN_LEVEL]
 
 
-def clipped(omega: ArrayLike, found: list[Plateaus]) -> np.ndarray:
-    """The samples of ``omega`` (rad/s, shape (n, 3)) at a clipped axis's range: on an axis
-    of ``found`` (:func:`gyro_plateaus`), a rate within :data:`STEP` of its plateaus' level
-    or beyond it. Boolean, shape (n,); all False when ``found`` is empty."""
+def gyro_range(found: list[Plateaus]) -> float:
+    """The range a record's gyro clips at: the lowest level among the axes ``found``
+    (:func:`gyro_plateaus`; one range for all three axes, as a MEMS gyro's full scale
+    is), 0 when none is."""
+    return min((p.level for p in found), default=0.0)
+
+
+def clipped(omega: ArrayLike, level: float) -> np.ndarray:
+    """The samples of ``omega`` (rad/s, shape (n, 3)) at a gyro range ``level`` (rad/s):
+    an axis's rate at :data:`~strapdown.ahrs._kernel.CLIP_NEAR` (0.98) of it or beyond, as
+    :func:`~strapdown.ahrs.ekf`'s kernel takes them. Boolean, shape (n,); all False when
+    ``level`` is 0 or infinite (no range known)."""
     w = np.asarray(omega, dtype=np.float64)
-    out = np.zeros(w.shape[0], dtype=bool)
-    for p in found:
-        out |= np.abs(w[:, p.axis]) >= (1.0 - STEP) * p.level
-    return out
+    if not 0.0 < level < np.inf:
+        return np.zeros(w.shape[0], dtype=bool)
+    return np.any(np.abs(w) >= K.CLIP_NEAR * level, axis=1)
 
 
 def warn_if_saturated(omega: ArrayLike, where: str) -> list[Plateaus]:

@@ -157,6 +157,7 @@ def _constants(cfg: AhrsConfig, params: K.Params, prop: dict, h: float, mag: boo
               "END_OFF": str(int(prop["end_off"])), "NODES": str(len(prop["offsets"])),
               "PAIRS": str(len(prop["pi"])), "MAG": str(int(mag)),
               "REST_ALPHA": _lit(h / cfg.rest_tau, real), "LEAD": _lit(lead, real),
+              "CLIP_NEAR": _lit(K.CLIP_NEAR, real),
               "PI": _lit(math.pi, real), "TINY": _lit(1e-300 if real == "double" else 1e-30,
                                                        real),
               "COS_DECL": _lit(math.cos(d), real), "SIN_DECL": _lit(math.sin(d), real),
