@@ -645,6 +645,7 @@ def _window_step(e, x, h, prop, offsets, weights, pi, pj, pc, ring, q, bias, phi
 #: gyro's plateaus are flat to 0.2 % (:mod:`strapdown.ahrs.saturation`).
 CLIP_NEAR = 0.98
 
+
 @njit(cache=True, inline="always", error_model="numpy")
 def _rate_at(k, x, h, is_rate, a):
     """The gyro's rate of sample k about axis a, rad/s, bias not removed: ``x[k]`` for
