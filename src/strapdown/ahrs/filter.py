@@ -410,7 +410,9 @@ class AhrsConfig:
         forces turned by two attitudes and its norm departs from gravity's without any
         sustained acceleration — it called the accelerometer disturbed and left the tilt
         on the gyro alone for as long as that lasted (RepoIMU's T-stick, test 05: for most
-        of each trial). :func:`offline_ekf` takes its tilt from the accelerometer directly
+        of each trial). Its limit: a sustained acceleration that coincides with the clip
+        (thrust on a body spinning beyond the range) is taken for gravity's direction while
+        the test is off. :func:`offline_ekf` takes its tilt from the accelerometer directly
         within this many seconds of every clipped sample, as where its passes contradict
         each other (``offline_consistency_gate``, ``_direct_tilt``): both passes carry the
         missed rotation on — the forward pass after each clip, the backward pass before
