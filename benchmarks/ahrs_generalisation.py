@@ -2,7 +2,7 @@
 
 Usage: ``python benchmarks/ahrs_generalisation.py [--seeds 0 1 … 19] [--aligned]
 [--hard-iron F --soft-iron F] [--gyro-scale SD --gyro-misalignment SD] [--acc-sample interval]
-[--set FIELD=VALUE ...] [--out reports/ahrs_generalisation.json]``.
+[--gyro-clip F] [--set FIELD=VALUE ...] [--out reports/ahrs_generalisation.json]``.
 
 Each seed draws the sensor errors and the random parts of the motions
 (:func:`strapdown.truth.scenarios.suite`, :func:`~strapdown.truth.scenarios.record`); each
@@ -23,6 +23,10 @@ per seed and recording (docs/reproductions.md, "A magnetometer that is not calib
 and cross-axis errors of these standard deviations drawn per seed and recording
 (``Sensors.gyro_scale_sd``, ``gyro_misalignment_sd``; a consumer MEMS gyro untrimmed: about
 0.01 and 0.005; docs/reproductions.md, "A gyro that is not calibrated").
+``--gyro-clip F`` gives every filter a gyro clipped at ``F`` times each recording's largest
+|rate| (:func:`clipped_gyro`; a gyro past its range, docs/reproductions.md, "A gyro past its
+range": the 0.3 m pendulum at 0.6 and 0.8; the other scenarios' peaks lie below 2 rad/s, under
+any gyro's range, or their plateaus are not found).
 ``--set FIELD=VALUE`` (repeatable) changes our filters' options (an ``AhrsConfig`` field,
 typed by it; e.g. ``--set gyro_scale_sigma=0.01``); VQF's stay its defaults.
 ``--acc-sample interval`` records every accelerometer sample as the mean specific force over
@@ -73,6 +77,13 @@ def uncalibrated(rec: SimulatedRecording, hard: float, soft: float,
     return dataclasses.replace(rec, mag=rec.mag @ S.T + b)
 
 
+def clipped_gyro(rec: SimulatedRecording, fraction: float) -> SimulatedRecording:
+    """``rec`` with its recorded gyro (noise and bias included) clipped at ``fraction`` of
+    its largest |rate| on any axis, as a gyro whose range is that is."""
+    level = fraction * float(np.abs(rec.gyro).max())
+    return dataclasses.replace(rec, gyro=np.clip(rec.gyro, -level, level))
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", type=int, nargs="+", default=list(range(SEEDS)))
@@ -89,6 +100,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--acc-sample", choices=["point", "interval"], default="point",
                     help="the simulated accelerometer's samples: at the stamps (the suite's) "
                     "or means over each period, like the gyro's")
+    ap.add_argument("--gyro-clip", type=float, default=0.0,
+                    help="clip the gyro at this fraction of each recording's peak rate "
+                    "(e.g. 0.6; default: not clipped)")
     ap.add_argument("--set", dest="config", action="append", default=[],
                     metavar="FIELD=VALUE", help="an AhrsConfig field of our filters (repeatable)")
     ap.add_argument("--out", default=None, help="write every figure as JSON here")
@@ -97,6 +111,9 @@ def main(argv: list[str] | None = None) -> int:
         config = AhrsConfig(**ahrs_config_fields(args.config))
     except ValueError as exc:
         ap.error(str(exc))
+    if not 0.0 <= args.gyro_clip < 1.0:
+        ap.error(f"--gyro-clip must lie in [0, 1): a fraction of the peak rate, got "
+                 f"{args.gyro_clip}")
     per_seed = {}
     names: list[str] = []
     for seed in args.seeds:
@@ -106,10 +123,12 @@ def main(argv: list[str] | None = None) -> int:
             gyro_misalignment_sd=args.gyro_misalignment)) for sc in suite(seed)]
         names = [s.name for s in scenarios]
         alter = None
-        if args.hard_iron or args.soft_iron:
+        if args.hard_iron or args.soft_iron or args.gyro_clip:
             def alter(rec, k, seed=seed):
-                rng = np.random.default_rng(1000 + 17 * seed + k)
-                return uncalibrated(rec, args.hard_iron, args.soft_iron, rng)
+                if args.hard_iron or args.soft_iron:
+                    rng = np.random.default_rng(1000 + 17 * seed + k)
+                    rec = uncalibrated(rec, args.hard_iron, args.soft_iron, rng)
+                return clipped_gyro(rec, args.gyro_clip) if args.gyro_clip else rec
         per_seed[seed] = evaluate(scenarios, seed=seed, aligned=args.aligned, alter=alter,
                                   config=config)
     header = ["scenario", *FILTERS, "ours/VQF causal", "ours/VQF offline"]
@@ -141,6 +160,8 @@ def main(argv: list[str] | None = None) -> int:
     if args.gyro_scale or args.gyro_misalignment:
         print(f"gyro uncalibrated: scale factors ±{args.gyro_scale:g}, cross-axis "
               f"±{args.gyro_misalignment:g} (standard deviations)")
+    if args.gyro_clip:
+        print(f"gyro clipped at {args.gyro_clip:g} of each recording's peak rate")
     if args.config:
         print("our filters with " + ", ".join(args.config))
     if args.out:
