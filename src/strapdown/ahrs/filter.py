@@ -1660,14 +1660,14 @@ def _near_clip(rec, cfg: AhrsConfig) -> np.ndarray:
     """The samples within ``gyro_clip_s`` of one at the gyro's range (``gyro_range``,
     resolved by :func:`_with_range`; :func:`~strapdown.ahrs.saturation.clipped`); all
     False when none is or the window is 0."""
+    from scipy.ndimage import maximum_filter1d
+
     near = clipped(rec.omega, cfg.gyro_range)
     if cfg.gyro_clip_s <= 0.0 or not near.any():
         return np.zeros_like(near)
-    w = round(cfg.gyro_clip_s / rec.td)
-    n = near.size
-    count = np.concatenate(([0], np.cumsum(near)))
-    k = np.arange(n)
-    return count[np.minimum(k + w + 1, n)] > count[np.maximum(k - w, 0)]
+    w = round(cfg.gyro_clip_s / rec.td)  # the window's half width, samples
+    return maximum_filter1d(near, 2 * w + 1, mode="constant", cval=False)
+
 
 def offline_ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
                 config: AhrsConfig | None = None, q0=None, gyro_bias0=None,
