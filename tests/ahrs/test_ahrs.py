@@ -190,8 +190,12 @@ def test_magnetic_anomaly_is_rejected_and_heading_recovers():
 
 def test_heading_recovery_after_recover_mag_s():
     """A wrong heading (30° in q0) that the gate keeps rejecting a clean field against is
-    recovered after ``recover_mag_s`` of rejections, not before; an anomaly that looks
-    clean and lasts longer than that is, by the same rule, taken as the truth."""
+    recovered after ``recover_mag_s`` of rejections, not before (the rule alone:
+    ``mag_adapt_s=0``); an anomaly that looks clean and lasts longer than that is, by the
+    same rule, taken as the truth. With the heading's variance adapted to its innovations
+    (the default) the clean field's innovations, counted at most as the gate, widen the
+    variance until the field gets through the gate within seconds, while the magnet's,
+    beyond the gate's width of the widened variance, still waits for the recovery."""
     from strapdown.truth import sensors
 
     h = 1 / 100
@@ -202,16 +206,24 @@ def test_heading_recovery_after_recover_mag_s():
     yaw = np.array([math.cos(math.radians(15)), 0.0, 0.0, math.sin(math.radians(15))])
     for recover in (10.0, 20.0):
         r = ekf(t, w, acc, clean, q0=quat_multiply(yaw, q[0]), mag_reference=M_N,
-                config=AhrsConfig(gyro_sample="point", recover_mag_s=recover))
+                config=AhrsConfig(gyro_sample="point", recover_mag_s=recover,
+                                  mag_adapt_s=0.0))
         e = np.degrees(attitude_error_angle(r.q, q[r.index]))
         first = t[np.flatnonzero(r.flags & Flag.MAG_RECOVERED)[0]]
         assert recover <= first < recover + 0.1
         assert e[t < first].min() > 29.0  # the gate held the wrong heading until then
         assert e[t > first + 5].max() < 0.5
+    adapted = ekf(t, w, acc, clean, q0=quat_multiply(yaw, q[0]), mag_reference=M_N,
+                  config=POINT)
+    e = np.degrees(attitude_error_angle(adapted.q, q[adapted.index]))
+    used = t[np.flatnonzero(adapted.flags & Flag.MAG_USED)[0]]
+    assert 1.0 < used < 10.0  # the gate held it at first, the widened variance let it in
+    assert e[t > 15.0].max() < 0.5 and not np.any(adapted.flags & Flag.MAG_RECOVERED)
     long = _anomalous_field(t, q, stop=50.0)
-    r = ekf(t, w, acc, long, q0=q[0], mag_reference=M_N, config=POINT)
-    first = t[np.flatnonzero(r.flags & Flag.MAG_RECOVERED)[0]]
-    assert 40.0 <= first < 40.1
+    for cfg in (POINT, replace(POINT, mag_adapt_s=0.0)):
+        r = ekf(t, w, acc, long, q0=q[0], mag_reference=M_N, config=cfg)
+        first = t[np.flatnonzero(r.flags & Flag.MAG_RECOVERED)[0]]
+        assert 40.0 <= first < 40.1
 
 
 def test_offline_combines_a_backward_pass_and_beats_the_causal_filter():

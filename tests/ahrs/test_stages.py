@@ -280,6 +280,36 @@ def test_tilt_adapt_factor_is_one_below_the_level_then_proportional_and_capped(k
     assert k._tilt_adapt(1e300, _params_of(tilt_adapt_level=math.inf)) == 1.0
 
 
+def test_heading_adapt_factor_is_the_mean_nis_above_one_and_one_near_a_clip(k):
+    """``m`` is 1 up to a mean NIS of 1 (a consistent filter's), the mean above it; 1
+    within ``gyro_clip_s`` of a clipped gyro sample whatever the mean."""
+    assert k._heading_adapt(0.0, False) == 1.0
+    assert k._heading_adapt(1.0, False) == 1.0
+    assert k._heading_adapt(7.5, False) == 7.5
+    assert k._heading_adapt(7.5, True) == 1.0
+    assert k._heading_adapt(math.nan, False) == 1.0
+
+
+@pytest.mark.parametrize("h", [0.002, 0.01, 0.04])
+def test_heading_power_is_a_moving_mean_of_the_capped_nis(k, h):
+    """A constant NIS reaches 1 − 1/e of itself after ``mag_adapt_s`` and itself after
+    many, at every sample rate; NaN leaves the mean; an NIS above the gate
+    (``mag_gate``) counts as the gate."""
+    p = _params_of(h=h, mag_adapt_s=2.0)
+    assert p.mag_adapt_k == pytest.approx(1.0 - math.exp(-h / 2.0), rel=1e-15)
+    assert p.mag_gate == 4.0
+    x, n = 0.0, round(2.0 / h)
+    for _ in range(n):
+        x = k._heading_power(x, 3.0, p)
+    assert x == pytest.approx(3.0 * (1 - math.exp(-1.0)), rel=1e-9)
+    for _ in range(20 * n):
+        x = k._heading_power(x, 3.0, p)
+    assert x == pytest.approx(3.0, rel=1e-9)
+    assert k._heading_power(x, math.nan, p) == x
+    assert k._heading_power(0.0, 1e6, p) == pytest.approx(p.mag_adapt_k * 4.0, rel=1e-12)
+    assert _params_of(h=h, mag_adapt_s=0.0).mag_adapt_k == 0.0
+
+
 @pytest.mark.parametrize("h", [0.002, 0.01, 0.04])
 def test_innovation_power_is_a_moving_mean_of_nis_per_second_whatever_the_rate(k, h):
     """A constant innovation of power ``y²/density²`` (R = density²/T, P negligible) gives
@@ -645,8 +675,9 @@ def test_consider_update_gain_stays_off_roll_and_pitch(k, nx):
     kk[6:] = 0.0
     A = np.eye(nx) - np.outer(kk, H[0])
     joseph = A @ P0 @ A.T + r * np.outer(kk, kk)
-    (nis, ok), dx = _consider(k, P, H, r, y)
+    (nis, ok, s_out), dx = _consider(k, P, H, r, y)
     assert ok and nis == pytest.approx(0.05**2 / S, rel=1e-13)
+    assert s_out == pytest.approx(S, rel=1e-13)
     assert np.allclose(dx, kk * 0.05, rtol=1e-12, atol=1e-18)
     assert np.allclose(P, joseph, rtol=1e-10, atol=1e-16)
     tilt = (C_HAT @ dx[:3])[:2]  # the correction in the reference frame: only about up
@@ -664,7 +695,7 @@ def test_consider_update_is_the_kalman_update_when_the_projection_is_neutral(k):
     S = (H @ P @ H.T)[0, 0] + r
     kk = (P @ H.T)[:, 0] / S
     expect = P - S * np.outer(kk, kk)
-    (_, ok), dx = _consider(k, P, H, r, np.array([0.1]))
+    (_, ok, _), dx = _consider(k, P, H, r, np.array([0.1]))
     assert ok and np.allclose(dx, 0.1 * kk, rtol=1e-13, atol=0)
     assert np.allclose(P, expect, rtol=1e-12, atol=1e-20)
 
@@ -674,13 +705,15 @@ def test_consider_update_gate(k):
     P = np.diag([1e-4] * 3 + [1e-6] * 3)
     H = np.hstack([-C_HAT[2], np.zeros(3)])[None]
     nis_expect = 0.05**2 / (1e-4 + 1e-4)
-    (nis, ok), dx = _consider(k, P, H, 1e-4, np.array([0.05]), gate=0.99 * nis_expect)
+    (nis, ok, s_out), dx = _consider(k, P, H, 1e-4, np.array([0.05]), gate=0.99 * nis_expect)
     assert not ok and nis == pytest.approx(nis_expect, rel=1e-12)
+    assert s_out == pytest.approx(2e-4, rel=1e-12)  # S also when rejected
     assert np.array_equal(P, np.diag([1e-4] * 3 + [1e-6] * 3)) and not dx.any()
-    (_, ok), dx = _consider(k, P, H, 1e-4, np.array([0.05]), gate=1.01 * nis_expect)
+    (_, ok, _), dx = _consider(k, P, H, 1e-4, np.array([0.05]), gate=1.01 * nis_expect)
     assert ok and dx.any()
     P = np.diag([1e-4] * 3 + [1e-6] * 3)
-    (_, ok), _ = _consider(k, P, H, 1e-4, np.array([0.05]), gate=0.5 * nis_expect, force=True)
+    (_, ok, _), _ = _consider(k, P, H, 1e-4, np.array([0.05]), gate=0.5 * nis_expect,
+                              force=True)
     assert ok
 
 

@@ -246,6 +246,8 @@ class Params(NamedTuple):
     adapt_k: float  #: gain per epoch of the innovation power's moving mean (tilt_adapt_s)
     clip_level: float  #: the gyro's range, rad/s (0: none known; AhrsConfig.gyro_range)
     clip_s: float  #: how long after a sample at it the norm test is suspended (gyro_clip_s)
+    mag_adapt_k: float  #: gain per epoch of the heading NIS's moving mean (mag_adapt_s; 0:
+    #: no adaptation, :func:`_heading_adapt`)
 
 
 class Initial(NamedTuple):
@@ -807,6 +809,40 @@ def _innovation_power(nis_rate, nis, T, params):
     if not nis >= 0.0:  # no NIS (NaN): nothing learned
         return nis_rate
     return nis_rate + params.adapt_k * (min(nis, params.acc_gate_lowpass) / T - nis_rate)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _heading_adapt(nis_mean, near_clip):
+    """Stage 6: the factor ``m`` on the field heading's measurement variance — the moving
+    mean ``nis_mean`` (:func:`_heading_power`) of the heading NIS against the unadapted
+    variance, when above 1 (a consistent filter's mean), else 1; 1 also within
+    ``gyro_clip_s`` of a clipped gyro sample (``near_clip``), where the heading measured
+    through the attitude is wrong with the rotation the gyro missed and the gate, not a
+    wider variance, is what keeps it out. Heading innovations persistently larger than
+    the model allows mean that the measured heading is worse than ``heading_noise`` says
+    — at a steep dip, the tilt's error beyond its covariance turned into heading by
+    tan(dip) (a swinging body, whose accelerometer never sees gravity alone), or a
+    field the norm and dip tests do not call disturbed — and that the gate would reject
+    a clean field for good; the grown variance keeps the field in use, weighed as it
+    deserves (an innovation-based adaptive measurement noise, Mohamed & Schwarz (1999),
+    as :func:`_tilt_adapt` is for the process noise)."""
+    if near_clip or not nis_mean > 1.0:
+        return 1.0
+    return nis_mean
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _heading_power(nis_mean, nis0, params):
+    """Stage 6, after a heading update (used or rejected) on an undisturbed field that
+    no recovery forced, away from a clipped gyro sample: the moving mean, gain
+    ``mag_adapt_k`` per epoch (time constant ``mag_adapt_s``), of the NIS against the
+    unadapted variance ``nis0``, each counted at most as the gate (``mag_gate``): one
+    outlier does not count as a run of them, and the factor stays below the gate — a
+    field off by more than the gate's width of the adapted variance (a magnet carried
+    along, which the norm and dip tests can miss) is still rejected."""
+    if not nis0 >= 0.0:
+        return nis_mean
+    return nis_mean + params.mag_adapt_k * (min(nis0, params.mag_gate) - nis_mean)
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -1454,7 +1490,8 @@ def _heading_model(ref_heading, C, mn, dx, H, y):
 
 @njit(cache=True, inline="always", error_model="numpy")
 def _consider_update(P, H, r, y, gate, gating, force, dx, C, u, K, nb):
-    """A gated scalar update whose gain is kept off roll and pitch; returns (NIS, accepted).
+    """A gated scalar update whose gain is kept off roll and pitch; returns (NIS,
+    accepted, S).
 
     ``S = H P Hᵀ + r`` with the full H (heading and, through the dip, tilt), so the
     heading measurement weighs less while the tilt is uncertain; the gain
@@ -1474,7 +1511,7 @@ def _consider_update(P, H, r, y, gate, gating, force, dx, C, u, K, nb):
     S = r + H[0, 0] * u[0] + H[0, 1] * u[1] + H[0, 2] * u[2]
     nis = y[0] * y[0] / S
     if gating and nis > gate and not force:
-        return nis, False
+        return nis, False, S
     kz = (C[2, 0] * u[0] + C[2, 1] * u[1] + C[2, 2] * u[2]) / S
     for i in range(n):
         K[i] = C[2, i] * kz if i < 3 else (u[i] / S if i < nb else 0.0)
@@ -1482,7 +1519,7 @@ def _consider_update(P, H, r, y, gate, gating, force, dx, C, u, K, nb):
         for j in range(n):
             P[i, j] += S * K[i] * K[j] - K[i] * u[j] - u[i] * K[j]
         dx[i] += K[i] * y[0]
-    return nis, True
+    return nis, True, S
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -1661,6 +1698,7 @@ def ekf_kernel(sensors, prop, window, params, init, out):
     rest_since = -1.0  # start of the current run of rest detections (−1: none)
     acc_bad_since = -1.0  # start of the current run of rejections (−1: none)
     nis_rate = 0.0  # the low-pass innovations' power (_innovation_power)
+    mag_nis_mean = 0.0  # the heading innovations' mean NIS (_heading_power)
     mag_bad_since = -1.0
     heading_unobserved = False  # the last epoch rejected a disturbed field (heading_bridge_noise)
     g_meas = params.gravity_measured  # gravity's norm as measured (or assumed, g_known false)
@@ -1850,17 +1888,21 @@ def ekf_kernel(sensors, prop, window, params, init, out):
                     flags |= _mag_recovery(P, C, params.recover_angle ** 2 if due
                                            else T * params.provisional_heading_q)
                 _heading_model(ref_heading, C, mn, dx, H_mag, y1)
-                nis_mag, ok = _consider_update(P, H_mag, params.heading_noise ** 2 / T
-                                               * (_disturbed_factor(params, nd, ms) if dist
-                                                  else 1.0),
-                                               y1, params.mag_gate,
-                                               params.gating, force, dx, C, ku, kk,
-                                               # off the gyro bias: the recovered heading
-                                               # of a start in motion (the start's error,
-                                               # not the bias's), and a disturbed field
-                                               # (its error is not white: it would teach
-                                               # the bias its own drift)
-                                               3 if provisional or dist else 6)
+                near_clip = tk - last_clip < params.clip_s
+                r_mag = params.heading_noise ** 2 / T * (_disturbed_factor(params, nd, ms)
+                                                         if dist else 1.0)
+                m_mag = _heading_adapt(mag_nis_mean, near_clip)
+                nis_mag, ok, s_mag = _consider_update(
+                    P, H_mag, r_mag * m_mag, y1, params.mag_gate, params.gating, force, dx, C,
+                    ku, kk,
+                    # off the gyro bias: the recovered heading of a start in motion (the
+                    # start's error, not the bias's), and a disturbed field (its error is
+                    # not white: it would teach the bias its own drift)
+                    3 if provisional or dist else 6)
+                if params.mag_adapt_k > 0.0 and not (dist or force or near_clip):
+                    # the NIS against the unadapted variance
+                    mag_nis_mean = _heading_power(
+                        mag_nis_mean, y1[0] * y1[0] / (s_mag - (m_mag - 1.0) * r_mag), params)
                 bits, mag_bad_since = _outcome(ok, tk, mag_bad_since, F_MAG_USED,
                                                F_MAG_REJECTED)
                 flags |= bits

@@ -277,6 +277,28 @@ class AhrsConfig:
     acc_gate, mag_gate : float
         NIS thresholds: χ² with 3 dof at 99.9 % (16.27) for the raw accelerometer; for
         the heading 4.0 (CV; 1 dof at 95.4 %).
+    mag_adapt_s : float
+        The field heading's measurement variance adapted to its innovations (both
+        filters, and the C export): the heading NIS against the unadapted variance
+        (``heading_noise² / T``), each counted at most as the gate (``mag_gate``), is
+        averaged over this many seconds — on an undisturbed field, outside recoveries and
+        away from a clipped gyro sample (``gyro_clip_s``) — and above 1, a consistent
+        filter's mean, the variance is multiplied by that average (an innovation-based
+        adaptive measurement noise, Mohamed & Schwarz (1999)); so the factor stays below
+        the gate, and a field off by more than the gate's width of the widened variance
+        is still rejected (a magnet carried along, whose field the norm and dip tests
+        can miss: ``tests/ahrs/test_ahrs.py``; counted up to 16 instead, it was used 30 %
+        of the time and turned the heading by 4.7°). At a steep dip the
+        heading measured through the attitude carries the tilt's error times tan(dip);
+        where the tilt is worse than its covariance says (a swinging body, whose
+        accelerometer never sees gravity alone) every innovation looked like a
+        disturbance and the gate rejected a clean field for good (RepoIMU's pendulum,
+        dip 72°: 97–100 % of it from the eighth second; the offline estimate 1.67×
+        offlineVQF). Near a clipped gyro sample the factor is 1: the heading is wrong
+        there with the missed rotation, and the gate keeps it out. Default 2 s (1, 2, 3
+        and 5 s compared: RepoIMU's pendulum and the simulated suite do not tell them
+        apart, BROAD's causal mean is best at 2 s; docs/reproductions.md); 0 switches it
+        off.
     mag_norm_tol : float
         The field is disturbed when its (low-passed) norm departs from the reference
         by more than this fraction … Default 0.12, not cross-validated: above the
@@ -648,6 +670,7 @@ class AhrsConfig:
     heading_noise: float = 0.0126
     acc_gate: float = 16.27
     mag_gate: float = 4.0
+    mag_adapt_s: float = 2.0
     mag_norm_tol: float = 0.12
     mag_dip_tol: float = 0.12215
     acc_model: str = "lowpass"
@@ -758,7 +781,7 @@ _MAY_BE_INFINITE = ("mag_reject_s", "offline_mag_reject_s", "moving_start_headin
 _ANY_SIGN = ("declination_deg",)
 _NON_NEGATIVE = ("lever_arm", "acc_motion_leak", "tilt_rate_noise", "heading_rate_noise",
                  "gyro_scale_sigma", "offline_heading_rate_noise", "offline_smooth_s",
-                 "offline_lowpass_wait", "gyro_range", "gyro_clip_s",
+                 "offline_lowpass_wait", "gyro_range", "gyro_clip_s", "mag_adapt_s",
                  "mag_reject_s", "rest_min_s", "mag_delay_s", "latency_s", "mag_delay_max_s",
                  "mag_disturbed_power", "offline_mag_reject_s", "mag_delay_z", "hard_iron_s",
                  "hard_iron_hold_s", "hard_iron_min_explained", "acc_scale_tol")
@@ -1124,6 +1147,7 @@ def _derived(cfg: AhrsConfig, ref, use_mag: bool, h: float, te: float,
             "adapt_k": 1.0 - math.exp(-te / cfg.tilt_adapt_s),
             "clip_level": cfg.gyro_range if cfg.gyro_range < math.inf else 0.0,
             "clip_s": cfg.gyro_clip_s,
+            "mag_adapt_k": 1.0 - math.exp(-te / cfg.mag_adapt_s) if cfg.mag_adapt_s > 0 else 0.0,
             "mag_delay": round(cfg.mag_delay_s / h),
             "mag_delay_max": max(round(cfg.mag_delay_max_s / h), round(cfg.mag_delay_s / h)),
             "mag_delay_alpha": min(1.0, h / cfg.mag_delay_tau_s), "store_covariance": False,
