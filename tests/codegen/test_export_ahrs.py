@@ -216,11 +216,7 @@ def test_a_still_start_shorter_than_the_window_equals_library(tmp_path, real):
     assert not F._still(rec, acc, cfg) and F._still_window(rec, acc, cfg) > 0
     res = ekf(t, gyro, acc, m)
     assert res.start_still
-    h = check_rate_record(t, gyro, min_samples=4).td
-    e, lib = build(tmp_path, h=h, real=real, mag=True, algorithm="rate-single",
-                   config=cfg, name=f"prefix_{real}")
-    q, rc, fl = run(e, lib, gyro, acc, m)
-    _equals_library(res, q, rc, fl, e.init_samples, real)
+    _c_equals_library(tmp_path, res, t, gyro, acc, m, cfg, real, f"prefix_{real}")
 
 
 def test_the_tilts_adapted_rate_noise_equals_library(tmp_path):
@@ -233,11 +229,7 @@ def test_the_tilts_adapted_rate_noise_equals_library(tmp_path):
     res = ekf(t, gyro, acc, m)
     off = ekf(t, gyro, acc, m, config=AhrsConfig(tilt_adapt_level=math.inf))
     assert np.abs(res.q - off.q).max() > 1e-4  # the adaptation acts on this record
-    h = check_rate_record(t, gyro, min_samples=4).td
-    e, lib = build(tmp_path, h=h, real="double", mag=True, algorithm="rate-single",
-                   config=AhrsConfig(), name="adapt_double")
-    q, rc, fl = run(e, lib, gyro, acc, m)
-    _equals_library(res, q, rc, fl, e.init_samples, "double")
+    _c_equals_library(tmp_path, res, t, gyro, acc, m, AhrsConfig(), "double", "adapt_double")
 
 
 def test_the_clipped_gyros_suspended_norm_test_equals_library(tmp_path):
@@ -254,11 +246,7 @@ def test_the_clipped_gyros_suspended_norm_test_equals_library(tmp_path):
         res = ekf(t, gyro, acc, m, config=cfg)
         off = ekf(t, gyro, acc, m, config=replace(cfg, gyro_clip_s=0.0))
     assert np.abs(res.q - off.q).max() > 1e-2  # the rule acts on this record
-    h = check_rate_record(t, gyro, min_samples=4).td
-    e, lib = build(tmp_path, h=h, real="double", mag=True, algorithm="rate-single",
-                   config=cfg, name="clip_double")
-    q, rc, fl = run(e, lib, gyro, acc, m)
-    _equals_library(res, q, rc, fl, e.init_samples, "double")
+    _c_equals_library(tmp_path, res, t, gyro, acc, m, cfg, "double", "clip_double")
 
 
 def test_the_adapted_heading_variance_equals_library(tmp_path):
@@ -272,11 +260,7 @@ def test_the_adapted_heading_variance_equals_library(tmp_path):
     res = ekf(t, gyro, acc, m, config=cfg)
     off = ekf(t, gyro, acc, m, config=replace(cfg, mag_adapt_s=0.0))
     assert np.abs(res.q - off.q).max() > 1e-2  # the rule acts on this record
-    h = check_rate_record(t, gyro, min_samples=4).td
-    e, lib = build(tmp_path, h=h, real="double", mag=True, algorithm="rate-single",
-                   config=cfg, name="heading_adapt_double")
-    q, rc, fl = run(e, lib, gyro, acc, m)
-    _equals_library(res, q, rc, fl, e.init_samples, "double")
+    _c_equals_library(tmp_path, res, t, gyro, acc, m, cfg, "double", "heading_adapt_double")
 
 
 def rocking_start(n=4000, fs=100.0, seed=5, scale=1.018):
@@ -314,6 +298,16 @@ def test_a_learned_gravity_equals_library(tmp_path, real):
                    config=AhrsConfig(), name=f"learn_{real}")
     q, rc, fl = run(e, lib, gyro, acc, m)
     _equals_library(res, q, rc, fl, max(e.moving_samples, e.init_samples), real)
+
+
+def _c_equals_library(tmp_path, res, t, gyro, acc, m, cfg, real, name):
+    """The 9-axis rate-single module for ``cfg`` built and run on the record: its rows
+    equal the library's result ``res`` (:func:`_equals_library`)."""
+    h = check_rate_record(t, gyro, min_samples=4).td
+    e, lib = build(tmp_path, h=h, real=real, mag=True, algorithm="rate-single", config=cfg,
+                   name=name)
+    q, rc, fl = run(e, lib, gyro, acc, m)
+    _equals_library(res, q, rc, fl, e.init_samples, real)
 
 
 def _equals_library(res, q, rc, fl, w, real):
