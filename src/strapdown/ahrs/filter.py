@@ -278,27 +278,26 @@ class AhrsConfig:
         NIS thresholds: χ² with 3 dof at 99.9 % (16.27) for the raw accelerometer; for
         the heading 4.0 (CV; 1 dof at 95.4 %).
     mag_adapt_s : float
-        The field heading's measurement variance adapted to its innovations (both
-        filters, and the C export): the heading NIS against the unadapted variance
-        (``heading_noise² / T``), each counted at most as the gate (``mag_gate``), is
-        averaged over this many seconds — on an undisturbed field, outside recoveries and
-        away from a clipped gyro sample (``gyro_clip_s``) — and above 1, a consistent
-        filter's mean, the variance is multiplied by that average (an innovation-based
-        adaptive measurement noise, Mohamed & Schwarz (1999)); so the factor stays below
-        the gate, and a field off by more than the gate's width of the widened variance
-        is still rejected (a magnet carried along, whose field the norm and dip tests
-        can miss: ``tests/ahrs/test_ahrs.py``; counted up to 16 instead, it was used 30 %
-        of the time and turned the heading by 4.7°). At a steep dip the
-        heading measured through the attitude carries the tilt's error times tan(dip);
-        where the tilt is worse than its covariance says (a swinging body, whose
-        accelerometer never sees gravity alone) every innovation looked like a
-        disturbance and the gate rejected a clean field for good (RepoIMU's pendulum,
-        dip 72°: 97–100 % of it from the eighth second; the offline estimate 1.67×
-        offlineVQF). Near a clipped gyro sample the factor is 1: the heading is wrong
-        there with the missed rotation, and the gate keeps it out. Default 2 s (1, 2, 3
-        and 5 s compared: RepoIMU's pendulum and the simulated suite do not tell them
-        apart, BROAD's causal mean is best at 2 s; docs/reproductions.md); 0 switches it
-        off.
+        The field heading's measurement variance adapted to its innovations (both filters,
+        and the C export): the heading NIS against the unadapted variance
+        (``heading_noise²/T``), each counted at most as the gate (``mag_gate``), is averaged
+        over this many seconds — on an undisturbed field, outside recoveries and away from a
+        clipped gyro sample (``gyro_clip_s``) — and above 1, a consistent filter's mean, the
+        variance is multiplied by that average (an innovation-based adaptive measurement
+        noise, Mohamed & Schwarz (1999)); so the factor stays below the gate, and a field
+        off by more than the gate's width of the widened variance is still rejected (a
+        magnet carried along, whose field the norm and dip tests can miss:
+        ``tests/ahrs/test_ahrs.py``; counted up to 16 instead, it was used 30 % of the time
+        and turned the heading by 4.7°). At a steep dip the heading measured through the
+        attitude carries the tilt's error times tan(dip); where the tilt is worse than its
+        covariance says (a swinging body, whose accelerometer never sees gravity alone)
+        every innovation looked like a disturbance and the gate rejected a clean field for
+        good (RepoIMU's pendulum, dip 72°: 97–100 % of it from the eighth second; the
+        offline estimate 1.67× offlineVQF). Near a clipped gyro sample the factor is 1: the
+        heading is wrong there with the missed rotation, and the gate keeps it out. Default
+        2 s (1, 2, 3 and 5 s compared: RepoIMU's pendulum and the simulated suite do not
+        tell them apart, BROAD's causal mean is best at 2 s; docs/reproductions.md); 0
+        switches it off.
     mag_norm_tol : float
         The field is disturbed when its (low-passed) norm departs from the reference
         by more than this fraction … Default 0.12, not cross-validated: above the
