@@ -272,9 +272,10 @@ class Outputs(NamedTuple):
     int64, nis (n, 2) (accelerometer, heading; NaN without an update), attitude_sigma
     (n, 3), attitude_cov (n, 3, 3) (of δθ_b) and bias_var (n, 3) (the gyro bias's
     variances; only with ``Params.store_covariance``), mag_delay (n,) int64 (the
-    magnetometer delay in use, samples) — and ``sample[e]``, epoch e's sample index;
-    other rows are left as they were (accel and acc_bias are not written without their
-    states)."""
+    magnetometer delay in use, samples), mag_nis0 (n,) (the heading NIS against the
+    unadapted variance, ``mag_adapt_s``; NaN without an update or where a recovery forced
+    it) — and ``sample[e]``, epoch e's sample index; other rows are left as they were
+    (accel and acc_bias are not written without their states)."""
 
     q: np.ndarray
     gyro_bias: np.ndarray
@@ -287,6 +288,7 @@ class Outputs(NamedTuple):
     attitude_cov: np.ndarray
     bias_var: np.ndarray
     mag_delay: np.ndarray
+    mag_nis0: np.ndarray
 
 
 # ---------------------------------------------------------------- small numerics
@@ -1575,7 +1577,7 @@ def ekf_kernel(sensors, prop, window, params, init, out):
     nx = init.P.shape[0]  # 6; 9 with the Singer state (raw model); + 3 with the acc bias
     singer = not params.acc_lowpass
     (out_q, out_b, out_a, out_ab, out_idx, out_flags, out_nis, out_sig, out_cov, out_bv,
-     out_md) = out
+     out_md, out_nis0) = out
     # the estimate: attitude, gyro bias, manoeuvre acceleration, accelerometer bias,
     # covariance, and the outputs of the last `lag` epochs (the sliding bases; with
     # lag 1 the row is q itself)
@@ -1831,6 +1833,7 @@ def ekf_kernel(sensors, prop, window, params, init, out):
         # stage 6: magnetometer (delay, disturbance, rejection or de-weighting, recovery,
         # the heading update)
         nis_mag = np.nan
+        nis0 = np.nan
         if params.use_magnetometer:
             if params.estimate_mag_delay:
                 last_d, n_delay_seen = _fold_delay_samples(last_d, k, n_delay_seen, x, mag, hv, h,
@@ -1899,10 +1902,10 @@ def ekf_kernel(sensors, prop, window, params, init, out):
                     # start's error, not the bias's), and a disturbed field (its error is
                     # not white: it would teach the bias its own drift)
                     3 if provisional or dist else 6)
-                if params.mag_adapt_k > 0.0 and not (dist or force or near_clip):
-                    # the NIS against the unadapted variance
-                    mag_nis_mean = _heading_power(
-                        mag_nis_mean, y1[0] * y1[0] / (s_mag - (m_mag - 1.0) * r_mag), params)
+                if not force:  # the NIS against the unadapted variance
+                    nis0 = y1[0] * y1[0] / (s_mag - (m_mag - 1.0) * r_mag)
+                    if params.mag_adapt_k > 0.0 and not (dist or near_clip):
+                        mag_nis_mean = _heading_power(mag_nis_mean, nis0, params)
                 bits, mag_bad_since = _outcome(ok, tk, mag_bad_since, F_MAG_USED,
                                                F_MAG_REJECTED)
                 flags |= bits
@@ -1944,6 +1947,7 @@ def ekf_kernel(sensors, prop, window, params, init, out):
         out_flags[k] = flags
         out_nis[k, 0] = nis_acc
         out_nis[k, 1] = nis_mag
+        out_nis0[k] = nis0
     if lp_n == 0:  # the low-pass model never ran: no state to hand on
         for a in range(3):
             lp[a] = np.nan

@@ -1229,7 +1229,8 @@ def _run(rec, acc, mag, prop: K.Propagation, window: K.Window, params: K.Params,
                     acc_bias=np.zeros((n, 3)), sample=np.empty(n, np.int64),
                     flags=np.zeros(n, np.int64), nis=np.empty((n, 2)),
                     attitude_sigma=np.empty((n, 3)), attitude_cov=np.empty((nc, 3, 3)),
-                    bias_var=np.empty((nc, 3)), mag_delay=np.zeros(n, np.int64))
+                    bias_var=np.empty((nc, 3)), mag_delay=np.zeros(n, np.int64),
+                    mag_nis0=np.full(n, np.nan))
     out.q[0] = init.q
     out.gyro_bias[0] = init.gyro_bias
     out.nis[0] = np.nan
@@ -1273,6 +1274,7 @@ def _fill(rec, out: K.Outputs, k: int) -> np.ndarray:
                   *((out.attitude_cov, out.bias_var) if out.bias_var.shape[0] == n else ())):
             a[held] = a[last[held]]
         out.nis[held] = np.nan
+        out.mag_nis0[held] = np.nan
         _fill_between_epochs(rec, out.q, out.gyro_bias, last)
     return epoch
 
@@ -1514,7 +1516,7 @@ def _backward(rec, acc, mag, have_mag: bool, cfg: AhrsConfig, algorithm: str, fw
     out.q[0] = fwd.q[-1]  # its start, at the last stamp (_to_stamps keeps a first row)
     rev = np.arange(n)[::-1]
     for f in ("q", "gyro_bias", "accel", "acc_bias", "flags", "nis", "attitude_sigma",
-              "attitude_cov", "bias_var"):
+              "attitude_cov", "bias_var", "mag_nis0"):
         getattr(out, f)[:] = getattr(out, f)[rev]
     out.gyro_bias[:] *= -1.0
     return out, epoch[rev]
@@ -1746,7 +1748,8 @@ def offline_ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
     fwd, epoch, gravity, _, lowpass = _filter(rec, acc, mag, have_mag, cfg_pass, algorithm,
                                               q_init, b0, ref, start, True)
     if (cfg.offline_heading_rate_noise < cfg.heading_rate_noise
-            and _clean_field_rejected(fwd.flags) > HEADING_ESCAPED_SHARE):
+            and _clean_field_rejected(fwd.flags, fwd.mag_nis0, cfg.mag_gate)
+            > HEADING_ESCAPED_SHARE):
         # the heading left its covariance: the passes again, with the causal rate noise
         cfg = replace(cfg, offline_heading_rate_noise=cfg.heading_rate_noise)
         cfg_pass = replace(cfg_pass, heading_rate_noise=cfg.heading_rate_noise)
@@ -1782,9 +1785,14 @@ def offline_ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
 HEADING_ESCAPED_SHARE = 0.25
 
 
-def _clean_field_rejected(flags: np.ndarray) -> float:
+def _clean_field_rejected(flags: np.ndarray, nis0: np.ndarray | None = None,
+                          gate: float = math.inf) -> float:
     """The share of the epochs with an undisturbed field (used or rejected, not
-    ``MAG_DISTURBED``) whose field the innovation gate rejected; 0 when there are none.
+    ``MAG_DISTURBED``) whose field the innovation gate rejected — or would have rejected
+    at the unadapted variance (``nis0`` beyond ``gate``: ``Outputs.mag_nis0``, NaN where
+    a recovery forced the update; ``mag_adapt_s`` widens the variance, and a heading that
+    runs away then leaves a smaller share of rejections, while the evidence that it left
+    its covariance is the same); 0 when there are none.
 
     A consistent filter's gate rejects a clean field's innovation with the gate's
     false-alarm probability — ``P(χ²₁ > mag_gate)``, 4.6 % at the default 4 — and a
@@ -1799,7 +1807,10 @@ def _clean_field_rejected(flags: np.ndarray) -> float:
     n = int(np.count_nonzero(seen))
     if n == 0:
         return 0.0
-    return float(np.count_nonzero(seen & ((flags & int(MeasurementFlag.MAG_REJECTED)) > 0))) / n
+    out = (flags & int(MeasurementFlag.MAG_REJECTED)) > 0
+    if nis0 is not None:
+        out |= nis0 > gate  # NaN compares False
+    return float(np.count_nonzero(seen & out)) / n
 
 
 def _warn_if_accelerometer_unused(result: AhrsResult, acc,
