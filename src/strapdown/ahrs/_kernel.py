@@ -31,7 +31,9 @@ a small function that numba inlines into the loop (``inline="always"``):
    (:func:`_mag_disturbance`, after Laidig & Seel (2023), Sec. 2.5), recovery
    (:func:`_mag_recovery`), :func:`_heading_model` and the heading update
    :func:`_consider_update`, whose innovation variance includes the tilt error
-   (through the field's dip) but whose gain never reaches roll and pitch;
+   (through the field's dip) but whose gain never reaches roll and pitch, and whose
+   measurement variance is adapted to its innovations (:func:`_heading_adapt`,
+   :func:`_heading_power`);
 7. :func:`_reset` — error-state injection into the attitude, the biases, the
    sliding scheme's bases and the low-pass states (:func:`_rotate_small`);
 8. the record: the epoch's sample's row of :class:`Outputs`.
