@@ -1780,8 +1780,9 @@ def offline_ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
 
 
 #: :func:`offline_ekf` runs its passes again with the causal ``heading_rate_noise`` when
-#: its forward pass's innovation gate rejected more than this share of the epochs whose
-#: field was undisturbed (:func:`_clean_field_rejected`).
+#: its forward pass's innovation gate rejected (or, at the unadapted variance of
+#: ``mag_adapt_s``, would have rejected) more than this share of the epochs whose field
+#: was undisturbed (:func:`_clean_field_rejected`).
 HEADING_ESCAPED_SHARE = 0.25
 
 
