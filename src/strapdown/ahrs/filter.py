@@ -342,8 +342,9 @@ class AhrsConfig:
         variance grown with the rotation weighed the field in motion — off by a few degrees
         there on BROAD — more than the other pass (offline mean 0.82× → 0.86×
         offlineVQF with 7e-4). Except where the gyro outruns that model: when the forward
-        pass's gate rejects more than ``HEADING_ESCAPED_SHARE`` (a quarter) of the epochs
-        whose field is undisturbed, both passes run again with ``heading_rate_noise``
+        pass's gate rejects (or, at the variance before ``mag_adapt_s`` widened it, would
+        reject) more than ``HEADING_ESCAPED_SHARE`` (a quarter) of the epochs whose field
+        is undisturbed, both passes run again with ``heading_rate_noise``
         (the result's ``config`` says so; an uncalibrated gyro on a sustained spin, 1 %
         scale error at 540 °/s: offline 81–118° → 5.6–8.3°, the causal filter 10–15°,
         offlineVQF 19–28°; BROAD's trials and the calibrated suite never reach it).
