@@ -1751,6 +1751,7 @@ def ekf_kernel(sensors, prop, window, params, init, out):
         flags = 0
         dx[:] = 0.0
         tk = k * h
+        near_clip = tk - last_clip < params.clip_s  # the gyro clipped within clip_s
         # stage 4: rest
         acc_quiet, at_rest = _rest_detect(ema_n, rest_alpha, params, gm, g2, am, a2, g_meas)
         at_rest = at_rest and _rest_still(k, x, acc, h, is_rate, params, gm, am)
@@ -1795,7 +1796,7 @@ def ekf_kernel(sensors, prop, window, params, init, out):
                 # was clipped within clip_s: the attitude then misses the rotation beyond
                 # its range, and the low-pass mixes specific forces turned by two attitudes
                 disturbed = (params.gating and not _lowpass_plausible(lp, params, g_meas)
-                             and not tk - last_clip < params.clip_s)
+                             and not near_clip)
                 ok = False
                 # lp_settle = 0: no update while the low-pass is still averaging its first
                 # lp_init_n epochs unless the accelerometer is quiet (a running mean of a
@@ -1893,7 +1894,6 @@ def ekf_kernel(sensors, prop, window, params, init, out):
                     flags |= _mag_recovery(P, C, params.recover_angle ** 2 if due
                                            else T * params.provisional_heading_q)
                 _heading_model(ref_heading, C, mn, dx, H_mag, y1)
-                near_clip = tk - last_clip < params.clip_s
                 r_mag = params.heading_noise ** 2 / T * (_disturbed_factor(params, nd, ms)
                                                          if dist else 1.0)
                 m_mag = _heading_adapt(mag_nis_mean, near_clip)
