@@ -21,7 +21,7 @@ from strapdown.rotation.error import attitude_error_angle
 from strapdown.rotation.euler import euler_zyx_from_dcm
 from strapdown.rotation.quaternion import quat_multiply
 from strapdown.truth.motions import SpinConing
-from suite_records import released_pendulum
+from suite_records import released_pendulum, suite_record
 
 ALGS = ["rate-single", "rate-three", "rate-three:structure=sliding", "rk4", "rotvec:N=3"]
 #: The simulated gyro samples the rate at each stamp (not its mean over the period before).
@@ -656,10 +656,8 @@ def test_a_record_cut_in_motion_converges(name, causal_deg, offline_deg):
     0.97° causal while the start's heading followed the field sample by sample,
     ``moving_start_heading_s``; VQF 5.6° on this record); the bounds are about twice that."""
     from strapdown.ahrs import offline_ekf, start_is_still
-    from strapdown.truth.scenarios import record, suite
 
-    k, sc = next((k, s) for k, s in enumerate(suite(0)) if s.name == name)
-    rec = record(sc, np.random.SeedSequence([0, k]))
+    rec = suite_record(name)
     i0 = int(np.searchsorted(rec.t, 15.0))
     g, a, m = (np.ascontiguousarray(x[i0:]) for x in (rec.gyro, rec.acc, rec.mag))
     t = rec.t[i0:] - rec.t[i0]
@@ -677,7 +675,6 @@ def test_a_still_window_measures_the_gyro_bias():
     √init_window_s``); a given ``gyro_bias0`` is kept, with ``gyro_bias_sigma0``; a start
     in motion starts from zero."""
     from strapdown.ahrs import filter as F
-    from strapdown.truth.scenarios import record, suite
 
     h = 0.01
     t = np.arange(400) * h
@@ -697,8 +694,7 @@ def test_a_still_window_measures_the_gyro_bias():
     assert np.array_equal(given.gyro_bias[0], [0.001, 0.0, 0.0])
     assert F._setup(t, w, acc, mag, cfg, None, [0.001, 0.0, 0.0], None, "ENU")[-1] \
         .gyro_bias_sigma0 is None  # the config's
-    k, sc = next((k, s) for k, s in enumerate(suite(0)) if s.name == "spin-coning")
-    rec = record(sc, np.random.SeedSequence([0, k]), duration_s=20.0)
+    rec = suite_record("spin-coning", duration_s=20.0)
     i0 = int(np.searchsorted(rec.t, 15.0))
     moving = ekf(rec.t[i0:] - rec.t[i0], rec.gyro[i0:], rec.acc[i0:], rec.mag[i0:])
     assert not moving.start_still and np.array_equal(moving.gyro_bias[0], np.zeros(3))

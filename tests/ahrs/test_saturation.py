@@ -16,7 +16,7 @@ from strapdown.ahrs import AhrsConfig, GyroSaturationWarning, ekf, offline_ekf
 from strapdown.ahrs.saturation import MIN_LEVEL, clipped, gyro_plateaus, gyro_range
 from strapdown.analysis.broad import broad_errors
 from strapdown.rotation.quaternion import quat_conjugate, quat_from_rotvec, quat_rotate
-from suite_records import clipped_pendulum
+from suite_records import clipped_pendulum, suite_record
 
 
 def _rocking(amplitude_rate: float, clip: float | None, n: int = 3000, h: float = 0.01):
@@ -66,10 +66,7 @@ def test_the_suites_steady_turns_and_spins_are_not_clipping(name):
     """A steady turn (the loiter: 0.17 rad/s; the vehicle) and a steady spin (9.4 rad/s,
     spun up over 3 s) are flat but not entered by a step; the 0.3 m pendulum's undamped
     peaks (5 rad/s, every swing the same) are smooth."""
-    from strapdown.truth.scenarios import record, suite
-
-    k, sc = next((k, s) for k, s in enumerate(suite(0)) if s.name == name)
-    assert gyro_plateaus(record(sc, np.random.SeedSequence([0, k])).gyro) == []
+    assert gyro_plateaus(suite_record(name).gyro) == []
 
 
 def test_the_clipped_samples_are_those_at_the_range():
@@ -115,10 +112,7 @@ def test_near_a_clipped_gyro_the_attitude_is_distrusted():
 @pytest.mark.parametrize("run", [ekf, offline_ekf])
 def test_an_unclipped_record_is_the_same_at_any_clip_window(run):
     """Unclipped, no range is found and nothing changes; a range above every rate neither."""
-    from strapdown.truth.scenarios import record, suite
-
-    k, sc = next((k, s) for k, s in enumerate(suite(0)) if s.name == "pendulum-0.3m-70deg")
-    rec = record(sc, np.random.SeedSequence([0, k]), duration_s=20.0)
+    rec = suite_record("pendulum-0.3m-70deg", duration_s=20.0)
     args = (rec.t, rec.gyro, rec.acc, rec.mag)
     a = run(*args)
     np.testing.assert_array_equal(a.q, run(*args, config=AhrsConfig(gyro_clip_s=0.0)).q)
