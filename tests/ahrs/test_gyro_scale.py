@@ -53,7 +53,8 @@ def spin():
             causal_on=ekf(rec.t, rec.gyro, rec.acc, rec.mag, config=ON),
             offline=offline_ekf(rec.t, rec.gyro, rec.acc, rec.mag),
             no_rule=offline_ekf(rec.t, rec.gyro, rec.acc, rec.mag,
-                                config=AhrsConfig(heading_rate_noise=0.0)))
+                                config=AhrsConfig(heading_rate_noise=0.0,
+                                                  offline_heading_rate_noise=0.0)))
 
 
 def test_the_bias_follows_the_scale_error_of_the_spin_and_holds_the_heading(spin):
@@ -129,8 +130,8 @@ def test_the_rerun_sees_through_the_adapted_heading_variance():
         warnings.simplefilter("ignore")
         out = offline_ekf(rec.t, rec.gyro, rec.acc, rec.mag)
         fwd = ekf(rec.t, rec.gyro, rec.acc, rec.mag,
-                  config=AhrsConfig(heading_rate_noise=0.0, hard_iron_s=0.0,
-                                    tilt_adapt_level=math.inf))
+                  config=AhrsConfig(heading_rate_noise=AhrsConfig().offline_heading_rate_noise,
+                                    hard_iron_s=0.0, tilt_adapt_level=math.inf))
     assert _clean_field_rejected(fwd.flags) < HEADING_ESCAPED_SHARE  # rejections alone
     assert out.config.offline_heading_rate_noise == AhrsConfig().heading_rate_noise
     assert _total(out, rec) < 6.0
@@ -147,7 +148,7 @@ def test_without_the_rule_the_offline_heading_runs_away(spin):
 def test_a_calibrated_gyro_keeps_the_offline_passes_as_they_were():
     rec = _recording("spin-coning", 0.0)
     out = offline_ekf(rec.t, rec.gyro, rec.acc, rec.mag)
-    assert out.config.offline_heading_rate_noise == 0.0
+    assert out.config.offline_heading_rate_noise == AhrsConfig().offline_heading_rate_noise
     assert _clean_field_rejected(out.flags) < 0.05
     assert _total(out, rec) < 0.5
 

@@ -337,11 +337,15 @@ class AhrsConfig:
         de-weighted, a strong one all but rejected. Defaults 2 (Laidig & Seel's
         magRejectionFactor) and 0; not cross-validated.
     offline_heading_rate_noise : float
-        ``heading_rate_noise`` in both passes of :func:`offline_ekf`. Default 0: the
-        smoother bridges a drifting stretch with the gyro from both sides, and a heading
-        variance grown with the rotation weighed the field in motion — off by a few degrees
-        there on BROAD — more than the other pass (offline mean 0.82× → 0.86×
-        offlineVQF with 7e-4). Except where the gyro outruns that model: when the forward
+        ``heading_rate_noise`` in both passes of :func:`offline_ekf`. Default 2.5e-4,
+        about a third of the causal filter's: the smoother bridges a drifting stretch with
+        the gyro from both sides, and a heading variance grown as fast as the causal
+        filter's weighed the field in motion — off by a few degrees there on BROAD — more
+        than the other pass (BROAD offline 1.523° at 2.5e-4, 1.516° at 0, 1.583° at 7e-4);
+        with none, the passes' heading did not follow the gyro's slow drift on a fast
+        spin, 0.1° over 20 s (the suite's spin-coning offline 1.08× offlineVQF at 0,
+        0.89× at 2.5e-4, 0.74× at 7e-4; docs/reproductions.md, "The offline passes'
+        heading rate noise"). Except where the gyro outruns that model: when the forward
         pass's gate rejects (or, at the variance before ``mag_adapt_s`` widened it, would
         reject) more than ``HEADING_ESCAPED_SHARE`` (a quarter) of the epochs whose field
         is undisturbed, both passes run again with ``heading_rate_noise``
@@ -691,7 +695,7 @@ class AhrsConfig:
     mag_reject_s: float = 10.0
     mag_disturbed_factor: float = 2.0
     mag_disturbed_power: float = 0.0
-    offline_heading_rate_noise: float = 0.0
+    offline_heading_rate_noise: float = 2.5e-4
     offline_mag_reject_s: float = math.inf
     offline_smooth_s: float = 4.0
     offline_lowpass_wait: float = 2.0
