@@ -12,7 +12,6 @@ noise cannot follow); the swinging 0.3 m pendulum with the same errors.
 from __future__ import annotations
 
 import dataclasses
-import math
 import warnings
 from types import SimpleNamespace
 
@@ -20,7 +19,7 @@ import numpy as np
 import pytest
 
 from strapdown.ahrs import AhrsConfig, ekf, offline_ekf
-from strapdown.ahrs.filter import HEADING_ESCAPED_SHARE, _clean_field_rejected
+from strapdown.ahrs.filter import HEADING_ESCAPED_SHARE, _clean_field_rejected, _pass_config
 from strapdown.ahrs.flags import MeasurementFlag as F
 from strapdown.analysis.broad import broad_errors
 from strapdown.truth.scenarios import record, suite
@@ -129,9 +128,7 @@ def test_the_rerun_sees_through_the_adapted_heading_variance():
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         out = offline_ekf(rec.t, rec.gyro, rec.acc, rec.mag)
-        fwd = ekf(rec.t, rec.gyro, rec.acc, rec.mag,
-                  config=AhrsConfig(heading_rate_noise=AhrsConfig().offline_heading_rate_noise,
-                                    hard_iron_s=0.0, tilt_adapt_level=math.inf))
+        fwd = ekf(rec.t, rec.gyro, rec.acc, rec.mag, config=_pass_config(AhrsConfig()))
     assert _clean_field_rejected(fwd.flags) < HEADING_ESCAPED_SHARE  # rejections alone
     assert out.config.offline_heading_rate_noise == AhrsConfig().heading_rate_noise
     assert _total(out, rec) < 6.0

@@ -1747,9 +1747,7 @@ def offline_ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
     rec, acc, mag, have_mag, q_init, b0, ref, start = _prepare(rec, acc, mag, have_mag, cfg,
                                                                 q0, gyro_bias0, mag_reference,
                                                                 frame)
-    # the passes share the reference field and the offset: no online estimate in either
-    cfg_pass = replace(cfg, heading_rate_noise=cfg.offline_heading_rate_noise, hard_iron_s=0.0,
-                       tilt_adapt_level=math.inf)
+    cfg_pass = _pass_config(cfg)
     fwd, epoch, gravity, _, lowpass = _filter(rec, acc, mag, have_mag, cfg_pass, algorithm,
                                               q_init, b0, ref, start, True)
     if (cfg.offline_heading_rate_noise < cfg.heading_rate_noise
@@ -1757,7 +1755,7 @@ def offline_ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
             > HEADING_ESCAPED_SHARE):
         # the heading left its covariance: the passes again, with the causal rate noise
         cfg = replace(cfg, offline_heading_rate_noise=cfg.heading_rate_noise)
-        cfg_pass = replace(cfg_pass, heading_rate_noise=cfg.heading_rate_noise)
+        cfg_pass = _pass_config(cfg)
         fwd, epoch, gravity, _, lowpass = _filter(rec, acc, mag, have_mag, cfg_pass,
                                                   algorithm, q_init, b0, ref, start, True)
     _to_stamps(fwd, rec.omega, rec, cfg)
@@ -1782,6 +1780,15 @@ def offline_ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
                              smoothed=True), mag_offset=offset)
     _warn_if_accelerometer_unused(result, acc, gravity, cfg, "offline_ekf")
     return result
+
+
+def _pass_config(cfg: AhrsConfig) -> AhrsConfig:
+    """The configuration :func:`offline_ekf`'s forward and backward passes run with: the
+    heading rate noise ``offline_heading_rate_noise``, no online hard-iron estimate (the
+    passes share the reference field and the whole record's offset) and no adapted tilt
+    noise (``tilt_adapt_level``; it cost there, :class:`AhrsConfig`)."""
+    return replace(cfg, heading_rate_noise=cfg.offline_heading_rate_noise, hard_iron_s=0.0,
+                   tilt_adapt_level=math.inf)
 
 
 #: :func:`offline_ekf` runs its passes again with the causal ``heading_rate_noise`` when
