@@ -12,8 +12,8 @@ scenario is run by ``strapdown EKF`` and ``VQF`` (causal), ``strapdown EKF offli
 constant world and body rotation to each estimate instead (the metric of the issue's held-back
 recordings). Prints, per scenario, the mean over the seeds of total / inclination RMSE and
 the geometric mean of ours/VQF (total) with its standard error, the worst seed's ratio and
-the number of seeds on which ours lost; ``strapdown benchmark-ahrs --suite generalisation``
-is one seed of it.
+the number of seeds on which ours lost, as ``strapdown benchmark-ahrs --suite generalisation``
+does (:func:`strapdown.apps.ahrs_generalisation.seeds_rows`), with the sensor errors below.
 
 ``--hard-iron F --soft-iron F`` gives every filter an uncalibrated magnetometer instead
 (:func:`uncalibrated`): the recorded field ``m`` becomes ``S m + F_h |m|_med d``, ``d`` a
@@ -38,31 +38,16 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import json
-import math
 import sys
 from pathlib import Path
 
 import numpy as np
 
 from strapdown.ahrs import AhrsConfig
-from strapdown.apps.ahrs_generalisation import FILTERS, evaluate
+from strapdown.apps.ahrs_generalisation import FILTERS, PAIRS, SEEDS, evaluate, ratios, seeds_rows
 from strapdown.cli._common import ahrs_config_fields
+from strapdown.io.files import markdown_table
 from strapdown.truth.scenarios import SimulatedRecording, suite
-
-_PAIRS = (("strapdown EKF", "VQF"), ("strapdown EKF offline", "offlineVQF"))
-#: Seeds by default: the ratio of two filters' errors on one recording spreads by a factor of
-#: about 1.4 from seed to seed (hand-held), so the geometric mean over five seeds moved by
-#: ±15 % with the seeds drawn (hand-held causal: 1.29 over seeds 0–4, 1.01 over 0–19).
-SEEDS = 20
-
-
-def ratio_cell(rs: list[float]) -> str:
-    """``geo ±se% (worst; lost/n)``: the geometric mean of the ratios, its standard error
-    (of the mean of the logs, in per cent), the worst ratio, on how many seeds ours lost."""
-    lr = np.log(rs)
-    se = float(np.std(lr, ddof=1) / np.sqrt(lr.size)) if lr.size > 1 else math.nan
-    return (f"{math.exp(lr.mean()):.2f} ±{100 * math.expm1(se):.0f}% "
-            f"({max(rs):.2f}; {sum(r > 1 for r in rs)}/{len(rs)})")
 
 
 def uncalibrated(rec: SimulatedRecording, hard: float, soft: float,
@@ -131,23 +116,15 @@ def main(argv: list[str] | None = None) -> int:
                 return clipped_gyro(rec, args.gyro_clip) if args.gyro_clip else rec
         per_seed[seed] = evaluate(scenarios, seed=seed, aligned=args.aligned, alter=alter,
                                   config=config)
-    header = ["scenario", *FILTERS, "ours/VQF causal", "ours/VQF offline"]
-    print("| " + " | ".join(header) + " |\n|" + "---|" * len(header))
+    print(markdown_table(*seeds_rows(per_seed, names)), end="")
     record = []
     for n in names:
-        cells = [n]
         entry: dict = {"scenario": n}
         for f in FILTERS:
-            tot = [r[(n, f)]["total_deg"] for r in per_seed.values() if (n, f) in r]
-            inc = [r[(n, f)]["inclination_deg"] for r in per_seed.values() if (n, f) in r]
-            cells.append(f"{np.mean(tot):.2f} / {np.mean(inc):.2f}" if tot else "—")
-            entry[f] = {"total_deg": tot, "inclination_deg": inc}
-        for a, b in _PAIRS:
-            rs = [r[(n, a)]["total_deg"] / r[(n, b)]["total_deg"] for r in per_seed.values()
-                  if (n, a) in r and (n, b) in r]
-            cells.append(ratio_cell(rs) if rs else "—")
-            entry[f"{a} / {b}"] = rs
-        print("| " + " | ".join(cells) + " |")
+            entry[f] = {k: [r[(n, f)][k] for r in per_seed.values() if (n, f) in r]
+                        for k in ("total_deg", "inclination_deg")}
+        for a, b in PAIRS:
+            entry[f"{a} / {b}"] = ratios(per_seed, n, a, b)
         record.append(entry)
     metric = ("after fitting a constant world and body rotation" if args.aligned
               else "BROAD's metric")

@@ -16,8 +16,8 @@ from strapdown.truth.scenarios import SCENARIO_KINDS, record, suite
 
 def test_short_suite_runs_every_filter_on_every_scenario(tmp_path, capsys):
     pytest.importorskip("vqf")
-    main(["benchmark-ahrs", "--suite", "generalisation", "--short", "--out", str(tmp_path),
-          "--no-progress"])
+    main(["benchmark-ahrs", "--suite", "generalisation", "--short", "--seed", "0", "--out",
+          str(tmp_path), "--no-progress"])
     out = capsys.readouterr().out
     names = [s.name for s in suite(0)]
     with open(tmp_path / "errors.csv", encoding="utf-8") as f:
@@ -114,8 +114,9 @@ def test_set_reaches_our_filters_only_and_is_named(tmp_path, capsys, monkeypatch
 
     monkeypatch.setattr(gen, "run_filter", fake)
     monkeypatch.setattr(gen, "_available", lambda _f: None)
-    main(["benchmark-ahrs", "--suite", "generalisation", "--short", "--out", str(tmp_path),
-          "--no-progress", "--set", "heading_noise=0.05", "--set", "gating=false"])
+    main(["benchmark-ahrs", "--suite", "generalisation", "--short", "--seed", "0", "--out",
+          str(tmp_path), "--no-progress", "--set", "heading_noise=0.05", "--set",
+          "gating=false"])
     ours = [c for f, c in seen if f.startswith("strapdown")]
     assert len(ours) == 2 * len(suite(0)) and len(seen) == len(FILTERS) * len(suite(0))
     assert all(c.heading_noise == 0.05 and c.gating is False for c in ours)
@@ -135,3 +136,85 @@ def test_a_bad_set_is_refused_before_anything_runs(tmp_path, capsys, item, said)
     assert exc.value.code == 2
     assert said in capsys.readouterr().err
     assert not (tmp_path / "r").exists()
+
+
+def test_several_seeds_give_the_mean_errors_and_the_ratios_spread(tmp_path, capsys,
+                                                                  monkeypatch):
+    """``--seeds 3,5``: every scenario run once per seed (its own draw), the table's cells
+    the mean over the seeds and its ratios the geometric mean with its standard error, the
+    worst seed and the seeds lost; every seed's ratio in ``ratios.csv``. The filters are
+    replaced by stubs whose errors are known: ours 2° then 0.5°, VQF 1°."""
+    import numpy as np
+
+    import strapdown.apps.ahrs_generalisation as gen
+
+    calls = []
+
+    def fake(name, tr, *, config=None):
+        calls.append(name)
+        return np.tile([1.0, 0.0, 0.0, 0.0], (tr.t.size, 1))
+
+    seen_seeds = []
+
+    def errors(q, q_ref, movement):
+        seed = seen_seeds[-1]
+        ours = calls[-1].startswith("strapdown")
+        e = (2.0 if seed == 3 else 0.5) if ours else 1.0
+        return {"total_deg": e, "heading_deg": e, "inclination_deg": e / 2}
+
+    real_suite = gen.suite
+
+    def suite(seed):
+        seen_seeds.append(seed)
+        return real_suite(seed)
+
+    monkeypatch.setattr(gen, "run_filter", fake)
+    monkeypatch.setattr(gen, "_available", lambda _f: None)
+    monkeypatch.setattr(gen, "broad_errors", errors)
+    monkeypatch.setattr(gen, "suite", suite)
+    main(["benchmark-ahrs", "--suite", "generalisation", "--short", "--seeds", "3,5",
+          "--out", str(tmp_path), "--no-progress"])
+    out = capsys.readouterr().out
+    assert seen_seeds[-2:] == [3, 5]
+    names = [s.name for s in real_suite(0)]
+    table = [line for line in out.splitlines() if line.startswith("| ")]
+    assert len(table) == 1 + len(names)
+    # ratios 2 and 0.5: geometric mean 1, logs ±ln 2, standard error ln 2 → +100 %
+    cells = [c.strip() for c in table[1].strip("| ").split("|")]
+    assert cells[1] == "1.25 / 0.62" and cells[2] == "1.00 / 0.50"
+    assert cells[-1] == cells[-2] == "1.00 ±100% (2.00; 1/2)"
+    assert "2 seeds" in out
+    with open(tmp_path / "ratios.csv", encoding="utf-8") as f:
+        rows = list(csv.DictReader(f))
+    assert [(r["seed"], r["ours/VQF causal"]) for r in rows[:: len(names)]] == [
+        ("3", "2.000"), ("5", "0.500")]
+    assert (tmp_path / "ratios.png").stat().st_size > 0
+    assert "Seeds 3, 5 (2)" in (tmp_path / "report.md").read_text(encoding="utf-8")
+
+
+def test_ratio_cell_from_known_ratios():
+    from strapdown.apps.ahrs_generalisation import ratio_cell
+
+    # logs −ln 2, ln 2, 0: sample standard deviation ln 2, standard error ln 2 / √3
+    assert ratio_cell([0.5, 2.0, 1.0]) == "1.00 ±49% (2.00; 1/3)"
+    assert ratio_cell([0.8]) == "0.80 (0.80; 0/1)"
+    assert ratio_cell([]) == "—"
+
+
+@pytest.mark.parametrize("spec, said", [("0-", "FIRST-LAST or a comma list"),
+                                        ("5-2", "FIRST <= LAST"),
+                                        ("1,1", "distinct"),
+                                        ("a", "FIRST-LAST or a comma list")])
+def test_bad_seeds_are_refused(capsys, spec, said):
+    with pytest.raises(SystemExit) as exc:
+        main(["benchmark-ahrs", "--suite", "generalisation", "--seeds", spec,
+              "--no-progress"])
+    assert exc.value.code == 2
+    assert said in capsys.readouterr().err
+
+
+def test_seed_and_seeds_exclude_each_other(capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["benchmark-ahrs", "--suite", "generalisation", "--seed", "1", "--seeds", "0-3"])
+    assert exc.value.code == 2
+    assert "not allowed with" in capsys.readouterr().err

@@ -55,8 +55,16 @@ def _arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--heading-offset-removed", action="store_true",
                    help="add a column with the total error after removing a constant heading "
                    "offset (not BROAD's metric; BROAD only)")
-    p.add_argument("--seed", type=int, default=0,
-                   help="generalisation: seed of the sensor errors and random motions")
+    seeds = p.add_mutually_exclusive_group()
+    seeds.add_argument("--seeds", type=_seeds, default=None, metavar="SEEDS",
+                       help="generalisation: the seeds of the sensor errors and random "
+                       "motions, as FIRST-LAST or a comma list (e.g. 0-19, 3,7); the table "
+                       "gives each scenario's mean errors and the geometric mean of the "
+                       "ratios over them, its standard error, the worst seed and how many "
+                       "ours lost (default: 0-19)")
+    seeds.add_argument("--seed", type=int, default=None,
+                       help="generalisation: one seed only (one draw of the sensor errors: "
+                       "a ratio on one recording spreads by about 1.4x from seed to seed)")
     p.add_argument("--short", action="store_true",
                    help="generalisation: the first 12 s of each scenario only (a quick check)")
     p.add_argument("--set", dest="config", action="append", default=[], metavar="FIELD=VALUE",
@@ -64,6 +72,24 @@ def _arguments(p: argparse.ArgumentParser) -> None:
                    "--set gyro_scale_sigma=0.01; the peers keep their defaults and the report "
                    "names what was changed (default: none, our filters' defaults)")
     progress_args(p, "a line as each trial and filter runs")
+
+
+def _seeds(text: str) -> list[int]:
+    """``--seeds``: ``FIRST-LAST`` (inclusive) or a comma list of non-negative integers."""
+    try:
+        if "-" in text.strip().lstrip("-"):
+            first, last = (int(x) for x in text.split("-"))
+            out = list(range(first, last + 1))
+        else:
+            out = [int(x) for x in text.split(",")]
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"expected FIRST-LAST or a comma list of seeds (e.g. 0-19 or 3,7), got {text!r}"
+        ) from None
+    if not out or min(out) < 0 or len(set(out)) != len(out):
+        raise argparse.ArgumentTypeError(
+            f"expected distinct non-negative seeds, FIRST <= LAST, got {text!r}")
+    return out
 
 
 def _config(args: argparse.Namespace) -> AhrsConfig | None:
@@ -75,16 +101,26 @@ def _config(args: argparse.Namespace) -> AhrsConfig | None:
 
 
 def _generalisation(args: argparse.Namespace, config: AhrsConfig | None) -> int:
-    from strapdown.apps.ahrs_generalisation import generalisation, summary_table
+    from strapdown.apps.ahrs_generalisation import SEEDS, generalisation, seeds_rows, summary_table
+    from strapdown.io.files import markdown_table
 
     if args.dir is not None:
         raise ValueError("--suite generalisation takes no DIR (its recordings are simulated)")
+    seeds = ([args.seed] if args.seed is not None else
+             args.seeds if args.seeds is not None else list(range(SEEDS)))
     out = args.out or "reports/benchmark-ahrs-generalisation"
-    res = generalisation(out, seed=args.seed, short=args.short, config=config,
+    res = generalisation(out, seeds=seeds, short=args.short, config=config,
                          progress=say if progress(args) else None)
-    print(summary_table(res, list(dict.fromkeys(n for n, _ in res))), end="")
-    print("cells: total / inclination RMSE (°, BROAD's metric, from 5 s); ratio: ours/VQF "
-          "of the same kind, total")
+    names = list(dict.fromkeys(n for n, _ in res[seeds[0]]))
+    if len(seeds) == 1:
+        print(summary_table(res[seeds[0]], names), end="")
+        print(f"seed {seeds[0]}; cells: total / inclination RMSE (°, BROAD's metric, from "
+              "5 s); ratio: ours/VQF of the same kind, total")
+    else:
+        print(markdown_table(*seeds_rows(res, names)), end="")
+        print(f"{len(seeds)} seeds; cells: mean total / inclination RMSE (°, BROAD's metric, "
+              "from 5 s); ratios: ours/VQF of the same kind, total, geometric mean over the "
+              "seeds ±its standard error (worst seed; seeds on which ours lost)")
     print(f"wrote {out}/report.md")
     return 0
 
