@@ -234,19 +234,24 @@ def test_the_tilts_adapted_rate_noise_equals_library(tmp_path):
 
 def test_the_clipped_gyros_suspended_norm_test_equals_library(tmp_path):
     """A gyro clipped at its range, given as ``gyro_range`` (the C export cannot find it
-    from a record): within ``gyro_clip_s`` of a clipped sample the low-pass model's norm
-    test is suspended (``_kernel._fold_clip_samples``). On the suite's 0.3 m pendulum
-    clipped at 60 % of its peak rate the rule acts (the library's output moves without
-    it), and the C follows the library row by row, double to ``DOUBLE_RAD`` with the same
-    flags."""
+    from a record): the clipped axes' rates taken from the field (``saturation.declip``,
+    one and two axes at once), and within ``gyro_clip_s`` of a clipped sample the low-pass
+    model's norm test suspended (``_kernel._fold_clip_samples``). On the suite's 0.3 m
+    pendulum clipped at 60 % of its peak rate both act (the library's output moves without
+    either), and the C follows the library row by row, double to ``DOUBLE_RAD`` with the
+    same flags; so it does without the field's rates."""
     t, gyro, acc, m, _truth, level = clipped_pendulum(duration_s=20.0)
     cfg = AhrsConfig(gyro_range=level)
+    kept = replace(cfg, gyro_declip=False)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", GyroSaturationWarning)
         res = ekf(t, gyro, acc, m, config=cfg)
         off = ekf(t, gyro, acc, m, config=replace(cfg, gyro_clip_s=0.0))
+        as_read = ekf(t, gyro, acc, m, config=kept)
     assert np.abs(res.q - off.q).max() > 1e-2  # the rule acts on this record
+    assert np.abs(res.q - as_read.q).max() > 1e-2  # so do the field's rates
     _c_equals_library(tmp_path, res, t, gyro, acc, m, cfg, "double", "clip_double")
+    _c_equals_library(tmp_path, as_read, t, gyro, acc, m, kept, "double", "clip_read_double")
 
 
 def test_the_adapted_heading_variance_equals_library(tmp_path):

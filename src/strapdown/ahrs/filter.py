@@ -80,7 +80,7 @@ import numpy as np
 from strapdown._core.validation import as_quaternions
 from strapdown.ahrs import _kernel as K
 from strapdown.ahrs.flags import MeasurementFlag
-from strapdown.ahrs.saturation import clipped, gyro_range, warn_if_saturated
+from strapdown.ahrs.saturation import clipped, declip, gyro_range, warn_if_saturated
 from strapdown.rotation.quaternion import quat_from_rotvec, quat_multiply
 
 __all__ = ["AccelerometerUnusedWarning", "AhrsConfig", "AhrsResult", "attitude_from_acc_mag",
@@ -452,6 +452,15 @@ class AhrsConfig:
         gyro clipped at 60 % / 80 % of its peak rate: causal 1.35× / 1.75× → 1.02× /
         1.05× VQF, offline 1.31× / 1.26× → 1.00× / 1.03× (docs/reproductions.md, "A gyro
         past its range").
+    gyro_declip : bool
+        Where one axis of the gyro is at its range (``gyro_range``) and the field lies
+        across that axis, take that axis's rate from the field's turn instead
+        (:func:`strapdown.ahrs.saturation.declip`: exact for a turn about the axis alone;
+        the field's noise does not accumulate over a run of samples), before anything else
+        sees the gyro, in :func:`ekf`, :func:`offline_ekf` and the C export alike. Default
+        on; nothing changes where no range is known or reached, or without a field. The
+        field must be calibrated and clean there: a hard-iron offset across the axis or a
+        disturbance is read as rotation.
     hard_iron_s : float
         :func:`ekf` estimates the magnetometer's hard-iron offset online, the causal form of
         :func:`strapdown.ahrs.hard_iron.hard_iron` (``_kernel._hard_iron_span``): every
@@ -703,6 +712,7 @@ class AhrsConfig:
     offline_consistency_gate: float = 50.0
     gyro_range: float = 0.0
     gyro_clip_s: float = 2.1
+    gyro_declip: bool = True
     hard_iron_s: float = 30.0
     hard_iron_hold_s: float = 5.0
     hard_iron_min_explained: float = 0.3
@@ -1356,15 +1366,20 @@ def _start(rec, acc, cfg: AhrsConfig, q0, mag_reference, still: int, path=None) 
 
 
 def _setup(t, gyro, acc, mag, cfg: AhrsConfig, q0, gyro_bias0, mag_reference, frame):
-    """Validated record and initial state: (rec, acc, mag, have_mag, q_init (ENU), b0,
-    reference field (norm, dip, heading), :class:`_Start`)."""
+    """:func:`ekf`'s record and initial state: the config with the gyro's range resolved
+    (:func:`_with_range`), then what :func:`_prepare` returns for the validated record with
+    the rate beyond that range taken from the field (:func:`_declipped`)."""
     rec, acc, mag, have_mag = _validate(t, gyro, acc, mag, cfg, frame)
-    return _prepare(rec, acc, mag, have_mag, cfg, q0, gyro_bias0, mag_reference, frame)
+    cfg = _with_range(cfg, warn_if_saturated(rec.omega, "ekf", stacklevel=4))
+    rec = _declipped(rec, mag, have_mag, cfg)
+    return (cfg, *_prepare(rec, acc, mag, have_mag, cfg, q0, gyro_bias0, mag_reference, frame))
 
 
 def _prepare(rec, acc, mag, have_mag: bool, cfg: AhrsConfig, q0, gyro_bias0, mag_reference,
              frame):
-    """:func:`_setup` on a record :func:`_validate` has checked."""
+    """Initial state of a record :func:`_validate` has checked (and :func:`_declipped`
+    completed): (rec, acc, mag, have_mag, q_init (ENU), b0, reference field (norm, dip,
+    heading), :class:`_Start`)."""
     w_still = _still_window(rec, acc, cfg)  # 0: a start in motion
     # a start in motion: one gyro path over its window for what needs it, its motion power
     # (the low-pass model) and its attitude (without q0)
@@ -1469,10 +1484,8 @@ def ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
     ValueError
         On invalid input, naming the problem.
     """
-    cfg = config or AhrsConfig()
-    rec, acc, mag, have_mag, q_init, b0, ref, start = _setup(t, gyro, acc, mag, cfg, q0,
-                                                              gyro_bias0, mag_reference, frame)
-    cfg = _with_range(cfg, warn_if_saturated(rec.omega, "ekf"))
+    cfg, rec, acc, mag, have_mag, q_init, b0, ref, start = _setup(
+        t, gyro, acc, mag, config or AhrsConfig(), q0, gyro_bias0, mag_reference, frame)
     out, epoch, gravity, offset, _ = _filter(rec, acc, mag, have_mag, cfg, algorithm, q_init,
                                              b0, ref, start)
     result = replace(_result(rec, out, epoch, frame, have_mag, algorithm, cfg, start),
@@ -1686,6 +1699,18 @@ def _with_range(cfg: AhrsConfig, found) -> AhrsConfig:
     return replace(cfg, gyro_range=gyro_range(found) or math.inf)
 
 
+def _declipped(rec, mag, have_mag: bool, cfg: AhrsConfig):
+    """``rec`` with the rate beyond the gyro's range (``gyro_range``, resolved by
+    :func:`_with_range`) taken from the field where one axis is clipped
+    (:func:`~strapdown.ahrs.saturation.declip`; ``gyro_declip``, with a field); as it is
+    otherwise. Before everything else sees the gyro, the initial window included, as the C
+    export does sample by sample."""
+    if not (cfg.gyro_declip and have_mag and 0.0 < cfg.gyro_range < math.inf):
+        return rec
+    omega, done = declip(rec.omega, mag, cfg.gyro_range, rec.td)
+    return replace(rec, omega=omega) if done.any() else rec
+
+
 def _near_clip(rec, cfg: AhrsConfig) -> np.ndarray:
     """The samples within ``gyro_clip_s`` of one at the gyro's range (``gyro_range``,
     resolved by :func:`_with_range`; :func:`~strapdown.ahrs.saturation.clipped`); all
@@ -1741,6 +1766,7 @@ def offline_ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
     cfg = config or AhrsConfig()
     rec, acc, mag, have_mag = _validate(t, gyro, acc, mag, cfg, frame)
     cfg = _with_range(cfg, warn_if_saturated(rec.omega, "offline_ekf"))
+    rec = _declipped(rec, mag, have_mag, cfg)
     offset = _hard_iron_offset(rec, mag, have_mag, cfg)
     if offset is not None:
         mag = mag - offset

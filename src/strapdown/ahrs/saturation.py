@@ -3,13 +3,15 @@
 No filter sees the rotation beyond the range: the attitude misses it, by degrees per
 plateau, until the accelerometer and the magnetometer pull it back. RepoIMU's T-stick
 (Szczęsna et al. (2016)) clips at 7.35 rad/s on its x axis on up to a fifth of a trial's
-samples, and every filter is tens of degrees off there (docs/reproductions.md, "RepoIMU's
+samples, and VQF is tens of degrees off there (docs/reproductions.md, "RepoIMU's
 T-stick"). :func:`gyro_plateaus` finds the signature in a record and :func:`ekf
 <strapdown.ahrs.ekf>` and :func:`offline_ekf <strapdown.ahrs.offline_ekf>` warn with it
-(:class:`GyroSaturationWarning`), and near a clipped sample (:func:`clipped`, at the range
-:func:`gyro_range` or ``AhrsConfig.gyro_range``) both distrust the attitude the gyro carried:
-``ekf`` suspends its low-pass accelerometer's norm test, ``offline_ekf`` takes its tilt from
-the accelerometer directly (``AhrsConfig.gyro_clip_s``).
+(:class:`GyroSaturationWarning`). Where one axis is clipped (:func:`clipped`, at the range
+:func:`gyro_range` or ``AhrsConfig.gyro_range``) and the field lies across that axis, both
+take the axis's rate from the field's turn instead (:func:`declip`,
+``AhrsConfig.gyro_declip``); and near a clipped sample both distrust the attitude the gyro
+carried: ``ekf`` suspends its low-pass accelerometer's norm test, ``offline_ekf`` takes its
+tilt from the accelerometer directly (``AhrsConfig.gyro_clip_s``).
 
 The signature, per axis: plateaus near the axis's largest rate — at least :data:`MIN_RUN`
 samples whose rate changes by no more than :data:`FLAT` of itself per sample — each entered
@@ -35,8 +37,9 @@ from numpy.typing import ArrayLike
 
 from strapdown.ahrs import _kernel as K
 
-__all__ = ["FLAT", "MIN_LEVEL", "MIN_RUN", "MIN_RUNS", "NEAR", "STEP", "GyroSaturationWarning",
-           "Plateaus", "clipped", "gyro_plateaus", "gyro_range", "warn_if_saturated"]
+__all__ = ["DECLIP_ACROSS", "FLAT", "MIN_LEVEL", "MIN_RUN", "MIN_RUNS", "NEAR", "STEP",
+           "GyroSaturationWarning", "Plateaus", "clipped", "declip", "gyro_plateaus",
+           "gyro_range", "warn_if_saturated"]
 
 #: Largest change per sample, relative to the rate, within a plateau.
 FLAT = 0.002
@@ -51,6 +54,17 @@ MIN_RUNS = 2
 #: Smallest level, rad/s: below every MEMS gyro's full scale (the smallest common one,
 #: 125 °/s, is 2.18 rad/s).
 MIN_LEVEL = 2.0
+#: :func:`declip` takes a clipped axis's rate from the field only where the field's part
+#: across that axis is at least this fraction of its norm (the sine of the angle between
+#: them: 5.7°; for two clipped axes, its part along the third); a field nearly along the
+#: axis turns too little about it to tell the rate, and the field's noise is amplified by
+#: the inverse. Chosen among 0.3, 0.2, 0.1, 0.05 and 0.02 on the suite's spin-coning read by
+#: a gyro clipped at 60 % and 80 % of its peak rate (the range given): its field comes
+#: within 8.2° of the spin axis (0.143) once a coning cycle, and 0.3 and 0.2 left those
+#: samples as read and the filter 95–109° off, 0.1 and below recovered every sample and
+#: gave 1.1–1.5° (seeds 0–2); the T-stick's and the clipped pendulums' fields lie well
+#: across (docs/reproductions.md, "The rate beyond the range, from the field").
+DECLIP_ACROSS = 0.1
 
 _AXES = "xyz"
 
@@ -104,15 +118,114 @@ def clipped(omega: ArrayLike, level: float) -> np.ndarray:
     return np.any(np.abs(w) >= K.CLIP_NEAR * level, axis=1)
 
 
-def warn_if_saturated(omega: ArrayLike, where: str) -> list[Plateaus]:
+def declip(omega: ArrayLike, mag: ArrayLike, level: float, h: float) -> tuple[np.ndarray,
+                                                                            np.ndarray]:
+    """The rate beyond a gyro's range, taken from the magnetometer: the clipped axes'
+    readings replaced by the rates the field's turn shows.
+
+    A field constant in the reference frame turns in the body frame. Over sample ``k``'s
+    period (the gyro's interval sample: its mean rate from ``t_{k−1}`` to ``t_k``), a turn by
+    θ about the unit axis ``n`` takes ``m_{k−1}`` to ``m_k`` with, exactly (the Cayley form
+    of the rotation), ``−Δm/h = c × m̄``: ``Δm = m_k − m_{k−1}``, ``m̄ = (m_k + m_{k−1})/2``
+    and ``c = (2/h) tan(θ/2) n``, the rate ``ω = (θ/h) n`` stretched by ``tan(θ/2)/(θ/2)``.
+    With the unclipped axes' readings in ``c`` (stretched by less than 0.2 % below 0.15 rad
+    a sample), the clipped axes' part ``u`` of ``c`` solves ``Σ_s u_s (e_s × m̄) = −Δm/h −
+    ω_⊥ × m̄`` in the least-squares sense (one axis: ``u = (e_a × m̄)·r / |e_a × m̄|²``; two:
+    their 2 × 2 normal equations); the rates taken are ``u`` shrunk back,
+    ``ω_s = u_s atan(|c| h/2) / (|c| h/2)``: exact for a turn about a clipped axis alone, at
+    any rate below π/h. The sum over a run of samples telescopes to the field's first and
+    last samples there, so the field's noise does not accumulate into the attitude.
+
+    Taken on samples ``k ≥ 1`` where one or two axes are at the range (``|ω_s| ≥``
+    :data:`~strapdown.ahrs._kernel.CLIP_NEAR` ``level``, as :func:`clipped`), both field
+    samples are finite and the field tells the clipped axes' rates apart: the normal
+    equations' determinant at least ``DECLIP_ACROSS²`` times ``|m̄|²`` per axis (one axis:
+    the field's part across it at least :data:`DECLIP_ACROSS` of its norm; two: its part
+    along the third axis). A turn about the field itself is invisible to it, so three
+    clipped axes are kept as read, as is every other sample. Units of the field cancel. The
+    field must be calibrated and undisturbed where it is used: a hard-iron offset across
+    the axis scales the rate taken by up to the offset's ratio to the field there, and a
+    disturbance's own turn is taken for the body's.
+
+    Parameters
+    ----------
+    omega : array_like, shape (n, 3)
+        Gyro rates, rad/s (interval samples).
+    mag : array_like, shape (n, 3)
+        The field at the same stamps, any units.
+    level : float
+        The gyro's range, rad/s (0 or infinite: none; nothing is replaced).
+    h : float
+        The sample period, s.
+
+    Returns
+    -------
+    omega : ndarray, shape (n, 3)
+        The rates with the recovered samples replaced (a copy).
+    recovered : ndarray of bool, shape (n, 3)
+        Which readings were replaced.
+    """
+    w = np.array(omega, dtype=np.float64)
+    m = np.asarray(mag, dtype=np.float64)
+    if w.ndim != 2 or w.shape[1] != 3 or m.shape != w.shape:
+        raise ValueError(f"omega and mag must have the same shape (n, 3), got {w.shape} and "
+                         f"{m.shape}")
+    out = np.zeros(w.shape, dtype=bool)
+    if not 0.0 < level < np.inf or w.shape[0] < 2:
+        return w, out
+    near = np.abs(w) >= K.CLIP_NEAR * level
+    n_near = near.sum(axis=1)
+    use = (n_near == 1) | (n_near == 2)
+    use[0] = False
+    use[1:] &= np.all(np.isfinite(m[1:]), axis=1) & np.all(np.isfinite(m[:-1]), axis=1)
+    rows = np.flatnonzero(use)
+    if rows.size == 0:
+        return w, out
+    nr = near[rows]
+    mb = 0.5 * (m[rows] + m[rows - 1])
+    r = -(m[rows] - m[rows - 1]) / h - np.cross(np.where(nr, 0.0, w[rows]), mb)
+    mm = np.einsum("ij,ij->i", mb, mb)
+    two = nr.sum(axis=1) == 2
+    # the clipped axes a (and b): the first (and last) clipped one
+    a = np.argmax(nr, axis=1)
+    b = 2 - np.argmax(nr[:, ::-1], axis=1)
+    ea = np.cross(np.eye(3)[a], mb)
+    eb = np.cross(np.eye(3)[b], mb)
+    g_aa = np.einsum("ij,ij->i", ea, ea)
+    g_ab = np.einsum("ij,ij->i", ea, eb)
+    g_bb = np.einsum("ij,ij->i", eb, eb)
+    r_a = np.einsum("ij,ij->i", ea, r)
+    r_b = np.einsum("ij,ij->i", eb, r)
+    det = np.where(two, g_aa * g_bb - g_ab * g_ab, g_aa)
+    ok = det >= DECLIP_ACROSS**2 * np.where(two, mm * mm, mm)
+    d = np.where(ok, det, 1.0)
+    u_a = np.where(two, (g_bb * r_a - g_ab * r_b) / d, r_a / d)
+    u_b = np.where(two, (g_aa * r_b - g_ab * r_a) / d, 0.0)
+    c = np.where(nr, 0.0, w[rows])
+    idx = np.arange(rows.size)
+    c[idx, a] = u_a
+    c[idx[two], b[two]] = u_b[two]
+    x = 0.5 * h * np.linalg.norm(c, axis=1)
+    shrink = np.where(x > 0.0, np.arctan(x) / np.where(x > 0.0, x, 1.0), 1.0)
+    for ax, u, sel in ((a, u_a, ok), (b, u_b, ok & two)):
+        w[rows[sel], ax[sel]] = shrink[sel] * u[sel]
+        out[rows[sel], ax[sel]] = True
+    return w, out
+
+
+def warn_if_saturated(omega: ArrayLike, where: str, stacklevel: int = 3) -> list[Plateaus]:
     """Warn (:class:`GyroSaturationWarning`) about every axis :func:`gyro_plateaus` finds,
-    naming ``where`` (the function the record went to); returns them."""
+    naming ``where`` (the function the record went to; ``stacklevel`` as
+    :func:`warnings.warn`'s, counted from here: 3 points at the caller of the function that
+    calls this); returns them."""
     found = gyro_plateaus(omega)
     for p in found:
         warnings.warn(
             f"{where}: gyro axis {_AXES[p.axis]} stops at {p.level:.3g} rad/s "
             f"({np.degrees(p.level):.0f} °/s) on {p.samples} samples in {p.runs} plateaus, "
-            f"each entered by a step: it looks clipped at its range, and the rotation beyond "
-            f"it is missing from the attitude there (a gyro range above the motion's rate "
-            f"avoids it)", GyroSaturationWarning, stacklevel=3)
+            f"each entered by a step: it looks clipped at its range; the rotation beyond it "
+            f"is taken from the magnetometer where the field lies across the axis "
+            f"(AhrsConfig.gyro_declip) and is missing from the attitude elsewhere (a gyro "
+            f"range above the motion's rate avoids it)", GyroSaturationWarning,
+            stacklevel=stacklevel)
     return found

@@ -35,6 +35,7 @@ from strapdown.ahrs import AhrsConfig
 from strapdown.ahrs import _kernel as K
 from strapdown.ahrs import filter as F
 from strapdown.ahrs.flags import MeasurementFlag
+from strapdown.ahrs.saturation import DECLIP_ACROSS
 
 __all__ = ["LEARNED", "AhrsExport", "export_ahrs", "generate_ahrs", "propagation_supported"]
 
@@ -45,7 +46,7 @@ LEARNED = ("ref_norm", "ref_dip", "ref_heading", "use_magnetometer", "gravity_me
            "gravity_known", "gravity_learned", "mag_provisional_s", "lp_settle")
 _NOT_IN_PRM = (*LEARNED, "store_covariance", "mag_delay_max", "rest_tau",
                *(f"{p}_{c}" for p in ("lp", "mc") for c in ("b0", "b1", "b2", "a1", "a2")))
-_MATH = ("sqrt", "sin", "cos", "atan2", "asin", "exp", "pow", "fabs")
+_MATH = ("sqrt", "sin", "cos", "atan", "atan2", "asin", "exp", "pow", "fabs")
 _FLOAT_LITERAL = re.compile(r"(?<![\w.])(\d+\.\d*(?:[eE][-+]?\d+)?|\d+[eE][-+]?\d+)(?![\w.])")
 
 
@@ -158,6 +159,8 @@ def _constants(cfg: AhrsConfig, params: K.Params, prop: dict, h: float, mag: boo
               "PAIRS": str(len(prop["pi"])), "MAG": str(int(mag)),
               "REST_ALPHA": _lit(h / cfg.rest_tau, real), "LEAD": _lit(lead, real),
               "CLIP_NEAR": _lit(K.CLIP_NEAR, real),
+              # saturation.declip's threshold; 0: gyro_declip off
+              "DECLIP_ACROSS": _lit(DECLIP_ACROSS if cfg.gyro_declip else 0.0, real),
               "PI": _lit(math.pi, real), "TINY": _lit(1e-300 if real == "double" else 1e-30,
                                                        real),
               "COS_DECL": _lit(math.cos(d), real), "SIN_DECL": _lit(math.sin(d), real),
