@@ -177,7 +177,8 @@ def test_declip_leaves_what_the_field_cannot_tell():
     """A field along the clipped axis (its part across below ``DECLIP_ACROSS``) turns too
     little about it: kept as read; so are samples clipped on two axes when the field has no
     part along the third, on all three, and everything when no range is known (0 or
-    infinite) or the field is not finite there."""
+    infinite) or the field is not finite there, or held (a sample equal to the one before:
+    a magnetometer slower than the gyro)."""
     _t, w, mag, _ = _spin(12.0, [1.0, 0.0, 0.0])
     read = np.clip(w, -7.0, 7.0)
     assert DECLIP_ACROSS > 0.0
@@ -197,6 +198,10 @@ def test_declip_leaves_what_the_field_cannot_tell():
     holed[5] = np.nan
     _, done = declip(read, holed, 7.0, 0.01)
     assert not done[5:7].any() and done[4, 0] and done[7, 0]
+    # a magnetometer at half the gyro's rate, each sample held once: no fresh pair
+    held = _spin(12.0, [0.5, 0.0, -0.8])[2]
+    held[1::2] = held[0:-1:2]
+    assert not declip(read, held, 7.0, 0.01)[1].any()
     with pytest.raises(ValueError, match=r"same shape \(n, 3\)"):
         declip(read, mag[:-1], 7.0, 0.01)
 

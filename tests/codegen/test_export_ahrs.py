@@ -239,7 +239,8 @@ def test_the_clipped_gyros_suspended_norm_test_equals_library(tmp_path):
     model's norm test suspended (``_kernel._fold_clip_samples``). On the suite's 0.3 m
     pendulum clipped at 60 % of its peak rate both act (the library's output moves without
     either), and the C follows the library row by row, double to ``DOUBLE_RAD`` with the
-    same flags; so it does without the field's rates."""
+    same flags; so it does without the field's rates, and with every fourth field sample
+    held (no rate from a held sample or the one after it)."""
     t, gyro, acc, m, _truth, level = clipped_pendulum(duration_s=20.0)
     cfg = AhrsConfig(gyro_range=level)
     kept = replace(cfg, gyro_declip=False)
@@ -252,6 +253,13 @@ def test_the_clipped_gyros_suspended_norm_test_equals_library(tmp_path):
     assert np.abs(res.q - as_read.q).max() > 1e-2  # so do the field's rates
     _c_equals_library(tmp_path, res, t, gyro, acc, m, cfg, "double", "clip_double")
     _c_equals_library(tmp_path, as_read, t, gyro, acc, m, kept, "double", "clip_read_double")
+    # every fourth field sample held (equal to the one before): no rate from it or the next
+    held = m.copy()
+    held[3::4] = held[2:-1:4]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", GyroSaturationWarning)
+        res_held = ekf(t, gyro, acc, held, config=cfg)
+    _c_equals_library(tmp_path, res_held, t, gyro, acc, held, cfg, "double", "clip_held_double")
 
 
 def test_the_adapted_heading_variance_equals_library(tmp_path):

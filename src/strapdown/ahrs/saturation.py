@@ -138,7 +138,9 @@ def declip(omega: ArrayLike, mag: ArrayLike, level: float, h: float) -> tuple[np
 
     Taken on samples ``k ≥ 1`` where one or two axes are at the range (``|ω_s| ≥``
     :data:`~strapdown.ahrs._kernel.CLIP_NEAR` ``level``, as :func:`clipped`), both field
-    samples are finite and the field tells the clipped axes' rates apart: the normal
+    samples are finite and fresh (a sample equal to the one before it was held by a
+    magnetometer slower than the gyro: it carries no turn, and the next one two periods'), and
+    the field tells the clipped axes' rates apart: the normal
     equations' determinant at least ``DECLIP_ACROSS²`` times ``|m̄|²`` per axis (one axis:
     the field's part across it at least :data:`DECLIP_ACROSS` of its norm; two: its part
     along the third axis). A turn about the field itself is invisible to it, so three
@@ -178,6 +180,11 @@ def declip(omega: ArrayLike, mag: ArrayLike, level: float, h: float) -> tuple[np
     use = (n_near == 1) | (n_near == 2)
     use[0] = False
     use[1:] &= np.all(np.isfinite(m[1:]), axis=1) & np.all(np.isfinite(m[:-1]), axis=1)
+    # a field sample equal to the one before was held, not read again: it carries no turn,
+    # and the next fresh one carries two periods' (a magnetometer slower than the gyro)
+    held = np.zeros(w.shape[0], dtype=bool)
+    held[1:] = np.all(m[1:] == m[:-1], axis=1)
+    use[1:] &= ~held[1:] & ~held[:-1]
     rows = np.flatnonzero(use)
     if rows.size == 0:
         return w, out
