@@ -421,3 +421,33 @@ def test_every_params_field_is_a_constant_or_learned():
         if f[:3] in ("lp_", "mc_") and f[3:] in ("b0", "b1", "b2", "a1", "a2"):
             continue
         assert re.search(rf"\.{f} = ", src), f
+
+
+def test_every_libm_call_of_the_template_is_counted():
+    """The operation count compiles the module with a counting type: every libm function
+    the template calls (``ahrs_c._MATH``, the names the float build suffixes) needs an
+    overload in ``count.hpp``, or the count's build fails (``atan`` had none when
+    ``saturation.declip`` first called it)."""
+    from strapdown.codegen import ahrs_c
+
+    hpp = (Path(ahrs_c.__file__).parent / "templates" / "count.hpp").read_text()
+    source = generate_ahrs(100.0, config=AhrsConfig()).source
+    for f in ahrs_c._MATH:
+        if re.search(rf"\b{f}\(", source):
+            assert re.search(rf"SD_FN1\({f}, |Counted<T> {f}\(", hpp), f
+
+
+def test_the_operation_count_runs(tmp_path):
+    """``count_operations`` builds the double module against the counting type and runs it
+    over a simulated recording: a positive count of each arithmetic class per update, and
+    the window's update far above the mean. Skipped without a C++ compiler."""
+    import shutil
+
+    from strapdown.codegen.ahrs_count import count_operations
+
+    if not (shutil.which("c++") or shutil.which("g++") or shutil.which("clang++")):
+        pytest.skip("no C++ compiler")
+    cost = count_operations(generate_ahrs(100.0, config=AhrsConfig(), name="count_ahrs"),
+                            seconds=4.0)
+    assert all(cost.mean[k] > 0 for k in ("add", "mul", "div", "sqrt", "cmp"))
+    assert cost.window["mul"] > 10 * cost.mean["mul"]

@@ -7,7 +7,7 @@ operation (``templates/count.hpp``) and fed a simulated recording at its sample 
 collected (mean and largest per update, the update that completes the initial window
 reported apart, since it runs the window's samples through the filter). Counted in the
 double build; the float build runs the same code. ``add`` counts additions and
-subtractions, ``trig`` sin, cos, asin and atan2, ``exp`` exp and pow, ``cmp`` floating
+subtractions, ``trig`` sin, cos, asin, atan and atan2, ``exp`` exp and pow, ``cmp`` floating
 comparisons and fabs. Needs a C++ compiler (``c++``, ``g++`` or ``clang++``).
 """
 

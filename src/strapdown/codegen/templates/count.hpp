@@ -54,6 +54,7 @@ SD_FN1(sqrt, SQRT)
 SD_FN1(sin, TRIG)
 SD_FN1(cos, TRIG)
 SD_FN1(asin, TRIG)
+SD_FN1(atan, TRIG)
 SD_FN1(exp, EXP)
 SD_FN1(fabs, CMP)
 #undef SD_FN1
