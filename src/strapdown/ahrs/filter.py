@@ -1373,7 +1373,7 @@ def _setup(t, gyro, acc, mag, cfg: AhrsConfig, q0, gyro_bias0, mag_reference, fr
     (:func:`_with_range`), then what :func:`_prepare` returns for the validated record with
     the rate beyond that range taken from the field (:func:`_declipped`)."""
     rec, acc, mag, have_mag = _validate(t, gyro, acc, mag, cfg, frame)
-    cfg = _with_range(cfg, warn_if_saturated(rec.omega, "ekf", stacklevel=4))
+    cfg = _with_range(cfg, _saturated(rec, mag, have_mag, cfg, "ekf", 5))
     rec = _declipped(rec, mag, have_mag, cfg)
     return (cfg, *_prepare(rec, acc, mag, have_mag, cfg, q0, gyro_bias0, mag_reference, frame))
 
@@ -1693,6 +1693,16 @@ def _direct_tilt(rec, acc, out: K.Outputs, bad: np.ndarray, cfg: AhrsConfig) -> 
     out.q[:] = quat_multiply(out.q, quat_from_rotvec(weight[:, None] * step))
 
 
+def _saturated(rec, mag, have_mag: bool, cfg: AhrsConfig, where: str, stacklevel: int):
+    """The clipped axes the record shows, warned about
+    (:func:`~strapdown.ahrs.saturation.warn_if_saturated`): the plateaus entered by a step,
+    or else, with a field to take the rate from (``gyro_declip``), those the field shows the
+    body turning beyond (:func:`~strapdown.ahrs.saturation.field_plateaus`)."""
+    use_field = have_mag and cfg.gyro_declip
+    return warn_if_saturated(rec.omega, where, stacklevel, mag if use_field else None,
+                             rec.td if use_field else None)
+
+
 def _with_range(cfg: AhrsConfig, found) -> AhrsConfig:
     """``cfg`` with ``gyro_range`` 0 (found from the record) replaced by the range the gyro
     is found clipped at (:func:`~strapdown.ahrs.saturation.gyro_range` of ``found``), or
@@ -1768,7 +1778,7 @@ def offline_ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
     """
     cfg = config or AhrsConfig()
     rec, acc, mag, have_mag = _validate(t, gyro, acc, mag, cfg, frame)
-    cfg = _with_range(cfg, warn_if_saturated(rec.omega, "offline_ekf"))
+    cfg = _with_range(cfg, _saturated(rec, mag, have_mag, cfg, "offline_ekf", 4))
     rec = _declipped(rec, mag, have_mag, cfg)
     offset = _hard_iron_offset(rec, mag, have_mag, cfg)
     if offset is not None:

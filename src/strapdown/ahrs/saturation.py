@@ -6,12 +6,13 @@ plateau, until the accelerometer and the magnetometer pull it back. RepoIMU's T-
 samples, and VQF is tens of degrees off there (docs/reproductions.md, "RepoIMU's
 T-stick"). :func:`gyro_plateaus` finds the signature in a record and :func:`ekf
 <strapdown.ahrs.ekf>` and :func:`offline_ekf <strapdown.ahrs.offline_ekf>` warn with it
-(:class:`GyroSaturationWarning`). Where one axis is clipped (:func:`clipped`, at the range
-:func:`gyro_range` or ``AhrsConfig.gyro_range``) and the field lies across that axis, both
-take the axis's rate from the field's turn instead (:func:`declip`,
-``AhrsConfig.gyro_declip``); and near a clipped sample both distrust the attitude the gyro
-carried: ``ekf`` suspends its low-pass accelerometer's norm test, ``offline_ekf`` takes its
-tilt from the accelerometer directly (``AhrsConfig.gyro_clip_s``).
+(:class:`GyroSaturationWarning`); where it finds none, a range entered smoothly (a spin-up)
+is found by the field (:func:`field_plateaus`). Where one or two axes are clipped
+(:func:`clipped`, at the range :func:`gyro_range` or ``AhrsConfig.gyro_range``) and the
+field tells their rates apart, both take those rates from the field's turn instead
+(:func:`declip`, ``AhrsConfig.gyro_declip``); and near a clipped sample both distrust the
+attitude the gyro carried: ``ekf`` suspends its low-pass accelerometer's norm test,
+``offline_ekf`` takes its tilt from the accelerometer directly (``AhrsConfig.gyro_clip_s``).
 
 The signature, per axis: plateaus near the axis's largest rate — at least :data:`MIN_RUN`
 samples whose rate changes by no more than :data:`FLAT` of itself per sample — each entered
@@ -37,9 +38,9 @@ from numpy.typing import ArrayLike
 
 from strapdown.ahrs import _kernel as K
 
-__all__ = ["DECLIP_ACROSS", "FLAT", "MIN_LEVEL", "MIN_RUN", "MIN_RUNS", "NEAR", "STEP",
-           "GyroSaturationWarning", "Plateaus", "clipped", "declip", "gyro_plateaus",
-           "gyro_range", "warn_if_saturated"]
+__all__ = ["DECLIP_ACROSS", "FIELD_MIN_S", "FIELD_RATIO", "FLAT", "MIN_LEVEL", "MIN_RUN",
+           "MIN_RUNS", "NEAR", "STEP", "GyroSaturationWarning", "Plateaus", "clipped", "declip",
+           "field_plateaus", "gyro_plateaus", "gyro_range", "warn_if_saturated"]
 
 #: Largest change per sample, relative to the rate, within a plateau.
 FLAT = 0.002
@@ -54,6 +55,17 @@ MIN_RUNS = 2
 #: Smallest level, rad/s: below every MEMS gyro's full scale (the smallest common one,
 #: 125 °/s, is 2.18 rad/s).
 MIN_LEVEL = 2.0
+#: :func:`field_plateaus`: an axis flat near its largest rate for at least this long in all
+#: (s), where the field turns at least :data:`FIELD_RATIO` times faster than the gyro reads.
+#: BROAD's smooth peaks are flat so for at most 0.08 s a trial, RepoIMU's pendulum's clipped
+#: ones for 0.1 s; the suite's spin clipped at 60–80 % for 35 s [m].
+FIELD_MIN_S = 0.5
+#: :func:`field_plateaus`: the field's turn over the flat samples, against the gyro's
+#: reading there. Measured where the gyro is not clipped: 0.994–1.009 (the suite's steady
+#: spin at 9.4 rad/s and its pendulums' peaks, seeds 0–4); where it is: 1.15–1.66 (the
+#: suite's 0.3 m pendulum and spin-coning clipped at 60 and 80 %), 1.17–1.63 (the
+#: T-stick's tests 10 and 05); the T-stick's test 06 reads 1.05 over 0.9 s [m].
+FIELD_RATIO = 1.1
 #: :func:`declip` takes a clipped axis's rate from the field only where the field's part
 #: across that axis is at least this fraction of its norm (the sine of the angle between
 #: them: 5.7°; for two clipped axes, its part along the third); a field nearly along the
@@ -98,6 +110,40 @@ def gyro_plateaus(omega: ArrayLike) -> list[Plateaus]:
     K.gyro_plateau_runs(w, NEAR, FLAT, STEP, MIN_RUN, runs, samples, level)
     return [Plateaus(a, int(runs[a]), float(level[a]), int(samples[a])) for a in range(3)
             if runs[a] >= MIN_RUNS and level[a] >= MIN_LEVEL]
+
+
+def field_plateaus(omega: ArrayLike, mag: ArrayLike, h: float) -> list[Plateaus]:
+    """The axes of a gyro record that stop at a level the field shows the body turning
+    beyond: a gyro clipped at its range and entered smoothly (a spin-up), which
+    :func:`gyro_plateaus` does not take for clipping without a step into the plateau.
+
+    Per axis: the plateaus of :func:`gyro_plateaus` without the entering step (a steady
+    spin or turn is such a plateau too), at a level of at least :data:`MIN_LEVEL`, lasting
+    :data:`FIELD_MIN_S` in all; at that level, the field's rate there (:func:`declip`, on
+    the samples it recovers, at least :data:`FIELD_MIN_S` of them) against the reading,
+    ``Σ sign(ω_a) u_a / Σ |ω_a|``, at least :data:`FIELD_RATIO`. The signed sum is the
+    field's turn over those samples, which telescopes; the field's noise averages out of it
+    where a sum of magnitudes would not. ``mag`` at the gyro's stamps, ``h`` the period.
+    Empty when none does."""
+    w = np.ascontiguousarray(omega, dtype=np.float64)
+    m = np.asarray(mag, dtype=np.float64)
+    if w.ndim != 2 or w.shape[1] != 3 or m.shape != w.shape:
+        raise ValueError(f"omega and mag must have the same shape (n, 3), got {w.shape} and "
+                         f"{m.shape}")
+    runs, samples, level = np.zeros(3, np.int64), np.zeros(3, np.int64), np.zeros(3)
+    K.gyro_plateau_runs(w, NEAR, FLAT, 0.0, MIN_RUN, runs, samples, level)
+    found = []
+    for a in range(3):
+        if not (runs[a] >= 1 and level[a] >= MIN_LEVEL and samples[a] * h >= FIELD_MIN_S):
+            continue
+        g, done = declip(w, m, float(level[a]), h)
+        sel = done[:, a]
+        if sel.sum() * h < FIELD_MIN_S:
+            continue
+        turn = float(np.sum(np.sign(w[sel, a]) * g[sel, a]))
+        if turn >= FIELD_RATIO * float(np.sum(np.abs(w[sel, a]))):
+            found.append(Plateaus(a, int(runs[a]), float(level[a]), int(samples[a])))
+    return found
 
 
 def gyro_range(found: list[Plateaus]) -> float:
@@ -220,19 +266,24 @@ def declip(omega: ArrayLike, mag: ArrayLike, level: float, h: float) -> tuple[np
     return w, out
 
 
-def warn_if_saturated(omega: ArrayLike, where: str, stacklevel: int = 3) -> list[Plateaus]:
-    """Warn (:class:`GyroSaturationWarning`) about every axis :func:`gyro_plateaus` finds,
-    naming ``where`` (the function the record went to; ``stacklevel`` as
-    :func:`warnings.warn`'s, counted from here: 3 points at the caller of the function that
-    calls this); returns them."""
+def warn_if_saturated(omega: ArrayLike, where: str, stacklevel: int = 3,
+                      mag: ArrayLike | None = None, h: float | None = None) -> list[Plateaus]:
+    """Warn (:class:`GyroSaturationWarning`) about every axis :func:`gyro_plateaus` finds —
+    or, when it finds none and a field ``mag`` at the gyro's stamps (period ``h``) is
+    given, every axis :func:`field_plateaus` finds — naming ``where`` (the function the
+    record went to; ``stacklevel`` as :func:`warnings.warn`'s, counted from here: 3 points
+    at the caller of the function that calls this); returns them."""
     found = gyro_plateaus(omega)
+    how = "each entered by a step"
+    if not found and mag is not None and h is not None:
+        found = field_plateaus(omega, mag, h)
+        how = f"where the field turns at least {FIELD_RATIO:g} times faster"
     for p in found:
         warnings.warn(
             f"{where}: gyro axis {_AXES[p.axis]} stops at {p.level:.3g} rad/s "
             f"({np.degrees(p.level):.0f} °/s) on {p.samples} samples in {p.runs} plateaus, "
-            f"each entered by a step: it looks clipped at its range; the rotation beyond it "
-            f"is taken from the magnetometer where the field lies across the axis "
-            f"(AhrsConfig.gyro_declip) and is missing from the attitude elsewhere (a gyro "
-            f"range above the motion's rate avoids it)", GyroSaturationWarning,
-            stacklevel=stacklevel)
+            f"{how}: it looks clipped at its range; the rotation beyond it is taken from the "
+            f"magnetometer where the field lies across the axis (AhrsConfig.gyro_declip) and "
+            f"is missing from the attitude elsewhere (a gyro range above the motion's rate "
+            f"avoids it)", GyroSaturationWarning, stacklevel=stacklevel)
     return found
