@@ -453,17 +453,21 @@ class AhrsConfig:
         1.05× VQF, offline 1.31× / 1.26× → 1.00× / 1.03× (docs/reproductions.md, "A gyro
         past its range").
     gyro_declip : bool
-        Where one or two axes of the gyro are at its range (``gyro_range``) and the field
-        tells their rates apart, take those axes' rates from the field's turn instead
-        (:func:`strapdown.ahrs.saturation.declip`: exact for a turn about a clipped axis
-        alone; the field's noise does not accumulate over a run of samples). Measured: the
-        T-stick's causal 1.03× → 0.35× VQF, the suite's 0.3 m pendulum clipped at 60 %
-        1.02× → 0.17× (docs/reproductions.md, "The rate beyond the range, from the
-        field"). Done before anything else sees the gyro, in :func:`ekf`,
-        :func:`offline_ekf` and the C export alike. Default on; nothing changes where no
-        range is known or reached, or without a field. The field must be calibrated and
-        clean there: a hard-iron offset across the axis or a disturbance is read as
-        rotation.
+        Where one or two axes of the gyro are at its range (``gyro_range``, given or found
+        from the record) and the field tells their rates apart — at least 5.7° off a clipped
+        axis (``saturation.DECLIP_ACROSS``), off the plane of two, never three — take those
+        axes' rates from the field's turn instead (:func:`strapdown.ahrs.saturation.declip`:
+        exact for a turn about a clipped axis alone; the field's noise does not accumulate
+        over a run of samples); and where the plateaus' steps find no range, find one the
+        field shows the body turning beyond (a spin-up past the range:
+        :func:`~strapdown.ahrs.saturation.field_plateaus`). Measured: the T-stick's causal
+        1.03× → 0.35× VQF, the suite's 0.3 m pendulum clipped at 60 % 1.02× → 0.17×
+        (docs/reproductions.md, "The rate beyond the range, from the field"). Done before
+        anything else sees the gyro, in :func:`ekf`, :func:`offline_ekf` and the C export
+        alike (there with the range given). Default on; nothing changes where no range is
+        known or reached, or without a field. The field must be sampled at the gyro's rate
+        (a held sample is skipped), calibrated and clean where it is used: a hard-iron
+        offset scales the rate taken, and a disturbance's own turn is read as the body's.
     hard_iron_s : float
         :func:`ekf` estimates the magnetometer's hard-iron offset online, the causal form of
         :func:`strapdown.ahrs.hard_iron.hard_iron` (``_kernel._hard_iron_span``): every

@@ -9,7 +9,8 @@ T-stick"). :func:`gyro_plateaus` finds the signature in a record and :func:`ekf
 (:class:`GyroSaturationWarning`); where it finds none, a range entered smoothly (a spin-up)
 is found by the field (:func:`field_plateaus`). Where one or two axes are clipped
 (:func:`clipped`, at the range :func:`gyro_range` or ``AhrsConfig.gyro_range``) and the
-field tells their rates apart, both take those rates from the field's turn instead
+field tells their rates apart, ``ekf`` and ``offline_ekf`` take those rates from the
+field's turn instead
 (:func:`declip`, ``AhrsConfig.gyro_declip``); and near a clipped sample both distrust the
 attitude the gyro carried: ``ekf`` suspends its low-pass accelerometer's norm test,
 ``offline_ekf`` takes its tilt from the accelerometer directly (``AhrsConfig.gyro_clip_s``).
@@ -118,13 +119,13 @@ def field_plateaus(omega: ArrayLike, mag: ArrayLike, h: float) -> list[Plateaus]
     :func:`gyro_plateaus` does not take for clipping without a step into the plateau.
 
     Per axis: the plateaus of :func:`gyro_plateaus` without the entering step (a steady
-    spin or turn is such a plateau too), at a level of at least :data:`MIN_LEVEL`, lasting
-    :data:`FIELD_MIN_S` in all; at that level, the field's rate there (:func:`declip`, on
-    the samples it recovers, at least :data:`FIELD_MIN_S` of them) against the reading,
-    ``Σ sign(ω_a) u_a / Σ |ω_a|``, at least :data:`FIELD_RATIO`. The signed sum is the
-    field's turn over those samples, which telescopes; the field's noise averages out of it
-    where a sum of magnitudes would not. ``mag`` at the gyro's stamps, ``h`` the period.
-    Empty when none does."""
+    spin or turn is such a plateau too; one plateau may do), at a level of at least
+    :data:`MIN_LEVEL`, lasting :data:`FIELD_MIN_S` s in all. At that level,
+    :func:`declip` recovers the rates ``ω̂_a`` of the samples at it (at least
+    :data:`FIELD_MIN_S` s of them); the field's turn over them against the reading,
+    ``Σ sign(ω_a) ω̂_a / Σ |ω_a|``, must be at least :data:`FIELD_RATIO`. The signed sum
+    telescopes, and the field's noise averages out of it where a sum of magnitudes would
+    not. ``mag`` at the gyro's stamps, ``h`` the period. Empty when none does."""
     w = np.ascontiguousarray(omega, dtype=np.float64)
     m = np.asarray(mag, dtype=np.float64)
     if w.ndim != 2 or w.shape[1] != 3 or m.shape != w.shape:
@@ -178,22 +179,27 @@ def declip(omega: ArrayLike, mag: ArrayLike, level: float, h: float) -> tuple[np
     a sample), the clipped axes' part ``u`` of ``c`` solves ``Σ_s u_s (e_s × m̄) = −Δm/h −
     ω_⊥ × m̄`` in the least-squares sense (one axis: ``u = (e_a × m̄)·r / |e_a × m̄|²``; two:
     their 2 × 2 normal equations); the rates taken are ``u`` shrunk back,
-    ``ω_s = u_s atan(|c| h/2) / (|c| h/2)``: exact for a turn about a clipped axis alone, at
-    any rate below π/h. The sum over a run of samples telescopes to the field's first and
-    last samples there, so the field's noise does not accumulate into the attitude.
+    ``ω_s = u_s atan(|c| h/2) / (|c| h/2)``: exact for a turn about a clipped axis alone, up
+    to nearly π/h (the test below applies to ``m̄``, whose part across the axis shrinks by
+    cos(θ/2): near π/h a sample is left as read). The sum over a run of samples telescopes
+    to the field's first and last samples there, so the field's noise does not accumulate
+    into the attitude (to second order in the field's norm).
 
     Taken on samples ``k ≥ 1`` where one or two axes are at the range (``|ω_s| ≥``
-    :data:`~strapdown.ahrs._kernel.CLIP_NEAR` ``level``, as :func:`clipped`), both field
-    samples are finite and fresh (a sample equal to the one before it was held by a
-    magnetometer slower than the gyro: it carries no turn, and the next one two periods'), and
-    the field tells the clipped axes' rates apart: the normal
-    equations' determinant at least ``DECLIP_ACROSS²`` times ``|m̄|²`` per axis (one axis:
-    the field's part across it at least :data:`DECLIP_ACROSS` of its norm; two: its part
-    along the third axis). A turn about the field itself is invisible to it, so three
-    clipped axes are kept as read, as is every other sample. Units of the field cancel. The
-    field must be calibrated and undisturbed where it is used: a hard-iron offset across
-    the axis scales the rate taken by up to the offset's ratio to the field there, and a
-    disturbance's own turn is taken for the body's.
+    :data:`~strapdown.ahrs._kernel.CLIP_NEAR` ``level``, as :func:`clipped`). Both field
+    samples must be finite and fresh: a sample equal to the one before was held (a
+    magnetometer slower than the gyro), carries no turn and makes the next carry two
+    periods', so both are skipped — the field must be sampled at the gyro's rate (held at
+    half of it, nothing is recovered; interpolated, its turn is spread over the held
+    period). The field must tell the clipped axes' rates apart: the normal equations'
+    determinant at least ``DECLIP_ACROSS²`` times ``|m̄|²`` per axis — one axis, the
+    field's part across it at least :data:`DECLIP_ACROSS` of its norm; two, its part along
+    the third axis. A turn about the field itself is invisible to it, so three clipped axes
+    are kept as read, as is every other sample. Units of the field cancel. The field must
+    be calibrated and undisturbed where it is used: a hard-iron offset ``b`` scales the rate
+    taken, sample by sample, by between ``1/(1 + β)`` and ``1/(1 − β)`` (β: ``b``'s part
+    across the axis over the field's), about 1 over whole turns; a disturbance's own turn
+    is read as the body's.
 
     Parameters
     ----------
@@ -272,18 +278,23 @@ def warn_if_saturated(omega: ArrayLike, where: str, stacklevel: int = 3,
     or, when it finds none and a field ``mag`` at the gyro's stamps (period ``h``) is
     given, every axis :func:`field_plateaus` finds — naming ``where`` (the function the
     record went to; ``stacklevel`` as :func:`warnings.warn`'s, counted from here: 3 points
-    at the caller of the function that calls this); returns them."""
+    at the caller of the function that calls this); returns them. ``mag`` given means the
+    caller takes the rate beyond the range from it (:func:`declip`), and the warning says
+    so."""
     found = gyro_plateaus(omega)
     how = "each entered by a step"
-    if not found and mag is not None and h is not None:
+    field = mag is not None and h is not None
+    if not found and field:
         found = field_plateaus(omega, mag, h)
         how = f"where the field turns at least {FIELD_RATIO:g} times faster"
+    beyond = ("the rotation beyond it is taken from the magnetometer where the field tells "
+              "it (AhrsConfig.gyro_declip) and is missing from the attitude elsewhere"
+              if field else "the rotation beyond it is missing from the attitude there "
+              "(no field to take it from, or AhrsConfig.gyro_declip off)")
     for p in found:
         warnings.warn(
             f"{where}: gyro axis {_AXES[p.axis]} stops at {p.level:.3g} rad/s "
             f"({np.degrees(p.level):.0f} °/s) on {p.samples} samples in {p.runs} plateaus, "
-            f"{how}: it looks clipped at its range; the rotation beyond it is taken from the "
-            f"magnetometer where the field lies across the axis (AhrsConfig.gyro_declip) and "
-            f"is missing from the attitude elsewhere (a gyro range above the motion's rate "
-            f"avoids it)", GyroSaturationWarning, stacklevel=stacklevel)
+            f"{how}: it looks clipped at its range; {beyond} (a gyro range above the "
+            f"motion's rate avoids it)", GyroSaturationWarning, stacklevel=stacklevel)
     return found
