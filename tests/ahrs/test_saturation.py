@@ -212,11 +212,19 @@ def test_the_fields_rate_beyond_the_range_corrects_the_pendulum():
     every swing clipped), from 5 s, total RMSE [m]: with the field's rate causal 2.1°,
     offline 1.1°, against 11.8° and 11.8° without it (VQF 11.8°, offlineVQF 11.9°, which
     read the clipped gyro)."""
-    t, gyro, acc, mag, truth, _level = clipped_pendulum()
+    t, gyro, acc, mag, truth, level = clipped_pendulum()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", GyroSaturationWarning)
-        assert _total(ekf(t, gyro, acc, mag).q, truth, t) < 2.5
-        assert _total(offline_ekf(t, gyro, acc, mag).q, truth, t) < 1.3
+        causal, offline = ekf(t, gyro, acc, mag), offline_ekf(t, gyro, acc, mag)
+        assert _total(causal.q, truth, t) < 2.5
+        assert _total(offline.q, truth, t) < 1.3
+        # the result counts the samples at the range (found: 0.2 % below the clip level)
+        # and those recovered: every one, the field lying across the swing's axes
+        n = int(clipped(gyro, level).sum())
+        for res in (causal, offline):
+            assert res.gyro_clipped >= n > 3000 and res.gyro_recovered == res.gyro_clipped
+        kept = ekf(t, gyro, acc, mag, config=AhrsConfig(gyro_declip=False))
+        assert kept.gyro_clipped == causal.gyro_clipped and kept.gyro_recovered == 0
         # without a field there is nothing to take it from
         six = ekf(t, gyro, acc, config=AhrsConfig(gyro_declip=True))
         np.testing.assert_array_equal(
@@ -229,6 +237,7 @@ def test_an_unclipped_record_is_the_same_at_any_clip_window(run):
     rec = suite_record("pendulum-0.3m-70deg", duration_s=20.0)
     args = (rec.t, rec.gyro, rec.acc, rec.mag)
     a = run(*args)
+    assert a.gyro_clipped == a.gyro_recovered == 0
     np.testing.assert_array_equal(a.q, run(*args, config=AhrsConfig(gyro_clip_s=0.0)).q)
     np.testing.assert_array_equal(a.q, run(*args, config=AhrsConfig(gyro_range=100.0)).q)
 

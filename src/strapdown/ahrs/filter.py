@@ -864,6 +864,10 @@ class AhrsResult:
         estimate's at the end (``AhrsConfig.hard_iron_s``; the flag
         ``MeasurementFlag.MAG_OFFSET`` marks the samples where it changed). None when none
         was.
+    gyro_clipped, gyro_recovered : int
+        The gyro samples at its range (``AhrsConfig.gyro_range``, given or found; 0 when
+        none is known), and how many of them had their clipped rates taken from the field
+        (``AhrsConfig.gyro_declip``).
     """
 
     t: np.ndarray
@@ -884,6 +888,8 @@ class AhrsResult:
     smoothed: bool = False
     start_still: bool = True
     mag_offset: np.ndarray | None = None
+    gyro_clipped: int = 0
+    gyro_recovered: int = 0
 
     def __post_init__(self):
         n = self.t.shape[0]
@@ -1374,12 +1380,14 @@ def _start(rec, acc, cfg: AhrsConfig, q0, mag_reference, still: int, path=None) 
 
 def _setup(t, gyro, acc, mag, cfg: AhrsConfig, q0, gyro_bias0, mag_reference, frame):
     """:func:`ekf`'s record and initial state: the config with the gyro's range resolved
-    (:func:`_with_range`), then what :func:`_prepare` returns for the validated record with
-    the rate beyond that range taken from the field (:func:`_declipped`)."""
+    (:func:`_with_range`), the clipped and recovered sample counts (:func:`_declipped`),
+    then what :func:`_prepare` returns for the validated record with the rate beyond that
+    range taken from the field."""
     rec, acc, mag, have_mag = _validate(t, gyro, acc, mag, cfg, frame)
     cfg = _with_range(cfg, _saturated(rec, mag, have_mag, cfg, "ekf", 5))
-    rec = _declipped(rec, mag, have_mag, cfg)
-    return (cfg, *_prepare(rec, acc, mag, have_mag, cfg, q0, gyro_bias0, mag_reference, frame))
+    rec, clip = _declipped(rec, mag, have_mag, cfg)
+    return (cfg, clip,
+            *_prepare(rec, acc, mag, have_mag, cfg, q0, gyro_bias0, mag_reference, frame))
 
 
 def _prepare(rec, acc, mag, have_mag: bool, cfg: AhrsConfig, q0, gyro_bias0, mag_reference,
@@ -1491,12 +1499,13 @@ def ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
     ValueError
         On invalid input, naming the problem.
     """
-    cfg, rec, acc, mag, have_mag, q_init, b0, ref, start = _setup(
+    cfg, clip, rec, acc, mag, have_mag, q_init, b0, ref, start = _setup(
         t, gyro, acc, mag, config or AhrsConfig(), q0, gyro_bias0, mag_reference, frame)
     out, epoch, gravity, offset, _ = _filter(rec, acc, mag, have_mag, cfg, algorithm, q_init,
                                              b0, ref, start)
     result = replace(_result(rec, out, epoch, frame, have_mag, algorithm, cfg, start),
-                     mag_offset=offset if np.any(offset) else None)
+                     mag_offset=offset if np.any(offset) else None, gyro_clipped=clip[0],
+                     gyro_recovered=clip[1])
     _warn_if_accelerometer_unused(result, acc, gravity, cfg, "ekf")
     return result
 
@@ -1721,11 +1730,14 @@ def _declipped(rec, mag, have_mag: bool, cfg: AhrsConfig):
     :func:`_with_range`) taken from the field where one or two axes are clipped
     (:func:`~strapdown.ahrs.saturation.declip`; ``gyro_declip``, with a field); as it is
     otherwise. Before everything else sees the gyro, the initial window included, as the C
-    export does sample by sample."""
-    if not (cfg.gyro_declip and have_mag and 0.0 < cfg.gyro_range < math.inf):
-        return rec
+    export does sample by sample. Also returns (the samples at the range, those of them
+    recovered)."""
+    n_clipped = int(clipped(rec.omega, cfg.gyro_range).sum())
+    if not (cfg.gyro_declip and have_mag and n_clipped):
+        return rec, (n_clipped, 0)
     omega, done = declip(rec.omega, mag, cfg.gyro_range, rec.td)
-    return replace(rec, omega=omega) if done.any() else rec
+    n_done = int(done.any(axis=1).sum())
+    return (replace(rec, omega=omega) if n_done else rec), (n_clipped, n_done)
 
 
 def _near_clip(rec, cfg: AhrsConfig) -> np.ndarray:
@@ -1783,7 +1795,7 @@ def offline_ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
     cfg = config or AhrsConfig()
     rec, acc, mag, have_mag = _validate(t, gyro, acc, mag, cfg, frame)
     cfg = _with_range(cfg, _saturated(rec, mag, have_mag, cfg, "offline_ekf", 4))
-    rec = _declipped(rec, mag, have_mag, cfg)
+    rec, clip = _declipped(rec, mag, have_mag, cfg)
     offset = _hard_iron_offset(rec, mag, have_mag, cfg)
     if offset is not None:
         mag = mag - offset
@@ -1820,7 +1832,8 @@ def offline_ekf(t, gyro, acc, mag=None, *, algorithm: str = "rate-single",
         broken = (tilt_nis > cfg.offline_consistency_gate) | _near_clip(rec, cfg)
         _direct_tilt(rec, acc, fwd, broken, cfg)
     result = replace(_result(rec, fwd, epoch, frame, have_mag, algorithm, cfg, start,
-                             smoothed=True), mag_offset=offset)
+                             smoothed=True), mag_offset=offset, gyro_clipped=clip[0],
+                     gyro_recovered=clip[1])
     _warn_if_accelerometer_unused(result, acc, gravity, cfg, "offline_ekf")
     return result
 

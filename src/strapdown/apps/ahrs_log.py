@@ -349,7 +349,8 @@ def _check_output(res: AhrsResult, gyro_units: str) -> None:
 
 def _merge(parts: list[AhrsResult], starts: list[int]) -> AhrsResult:
     """One result from the segments': every per-output array concatenated, the sample
-    indices offset to the whole recording."""
+    indices offset to the whole recording, the gyro's clipped and recovered samples
+    summed."""
     if len(parts) == 1:
         return parts[0]
     cat: dict[str, Any] = {}
@@ -358,6 +359,8 @@ def _merge(parts: list[AhrsResult], starts: list[int]) -> AhrsResult:
         if isinstance(first, np.ndarray) and first.shape[:1] == parts[0].t.shape:
             cat[f.name] = np.concatenate([getattr(p, f.name) for p in parts])
     cat["index"] = np.concatenate([p.index + s for p, s in zip(parts, starts, strict=True)])
+    for name in ("gyro_clipped", "gyro_recovered"):  # counts over the whole recording
+        cat[name] = sum(getattr(p, name) for p in parts)
     return dataclasses.replace(parts[0], **cat)
 
 
@@ -545,6 +548,8 @@ def _metadata(imu: Path, log: AhrsLog, res: AhrsResult, algorithm: str, frame: s
                   "gravity's norm nominal until the first rest)"),
         "mag_hard_iron_subtracted": (None if res.mag_offset is None
                                      else [float(x) for x in res.mag_offset]),
+        "gyro_at_range": {"samples": res.gyro_clipped,
+                          "recovered_from_field": res.gyro_recovered},
         "gyro_units": log.gyro_units, "acc_units": log.acc_units,
         "units_inferred": log.inferred, **base.to_dict(),
         "columns": ["t", "qw", "qx", "qy", "qz", "yaw_deg", "pitch_deg", "roll_deg", "bias_x",

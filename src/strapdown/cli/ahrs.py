@@ -149,6 +149,10 @@ def run(args: argparse.Namespace) -> int:
         say("note: the magnetometer carries a hard-iron offset (a field fixed in the body); "
             f"{how} {[round(float(x), 6) for x in res.mag_offset]} "
             f"(its unit; see AhrsConfig.{see})")
+    if res.gyro_clipped:
+        say(f"note: the gyro is at its range on {res.gyro_clipped} samples; the field's turn "
+            f"gave the rate beyond it on {res.gyro_recovered} of them (AhrsConfig.gyro_declip"
+            "; the others keep the clipped reading)")
     if not res.start_still:
         say("note: the recording starts in motion (its first "
             f"{cfg.init_window_s:g} s are not still): the first seconds converge from a "
