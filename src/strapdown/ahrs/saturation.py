@@ -284,7 +284,7 @@ def warn_if_saturated(omega: ArrayLike, where: str, stacklevel: int = 3,
     found = gyro_plateaus(omega)
     how = "each entered by a step"
     field = mag is not None and h is not None
-    if not found and field:
+    if not found and mag is not None and h is not None:
         found = field_plateaus(omega, mag, h)
         how = f"where the field turns at least {FIELD_RATIO:g} times faster"
     beyond = ("the rotation beyond it is taken from the magnetometer where the field tells "
