@@ -279,3 +279,22 @@ def test_cli_rejects_a_negative_verify(tmp_path, capsys):
               str(tmp_path / "x.png")])
     assert exc.value.code == 2
     assert "--verify must be ≥ 0" in capsys.readouterr().err
+
+
+def test_cli_warns_of_a_clipped_gyro(tmp_path, capsys):
+    """A rate log rocking at 10 rad/s about x, read by a gyro clipped at 7: the spectrum
+    misses the rate beyond the range, and the command says so (the axis, the level); the
+    same log unclipped draws no such warning."""
+    h, n = 0.005, 4000
+    t = np.arange(n) * h
+    rate = 10.0 * np.cos(2 * np.pi * 2.0 * t)
+    for clip, warned in ((7.0, True), (None, False)):
+        x = rate if clip is None else np.clip(rate, -clip, clip)
+        path = tmp_path / f"r{clip}.csv"
+        np.savetxt(path, np.column_stack([t, x, 0.3 * np.sin(2 * np.pi * 2.0 * t),
+                                          np.zeros(n)]), delimiter=",", fmt="%.17g",
+                   comments="", header="t,gx[rad/s],gy[rad/s],gz[rad/s]")
+        assert main(["advise", "--imu", str(path), "--no-verify", "--figure",
+                     str(tmp_path / "a.png")]) == 0
+        err = capsys.readouterr().err
+        assert ("gyro axis x stops at 7 rad/s" in err) is warned, err

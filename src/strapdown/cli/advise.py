@@ -132,6 +132,8 @@ def run(args: argparse.Namespace) -> int:
     figure = args.figure if args.figure is not None or args.json else "advise.png"
     stage(f"spectrum of {args.imu or args.psd}")
     f, g, h, segments, kind, log = _spectrum(args)
+    if log is not None:
+        _warn_if_clipped(log)
     if log is not None and args.verify > 0:
         stage("band-limited reference attitude of the log")
     ref = log_reference(log) if log is not None and args.verify > 0 else None
@@ -159,6 +161,19 @@ def run(args: argparse.Namespace) -> int:
     print("\n".join(_table(adv, ref)))
     say(f"figure: {figure}")
     return 0
+
+
+def _warn_if_clipped(log) -> None:
+    """Say so when the log's gyro looks clipped at its range
+    (:func:`strapdown.ahrs.saturation.gyro_plateaus` on its rates): the spectrum, and so
+    every candidate's predicted drift, misses the rate beyond the range."""
+    from strapdown.ahrs.saturation import gyro_plateaus
+
+    rates = log.data if log.kind == "rate" else log.data / log.h
+    for p in gyro_plateaus(rates):
+        say(f"warning: gyro axis {'xyz'[p.axis]} stops at {p.level:.3g} rad/s on {p.samples} "
+            f"samples in {p.runs} plateaus, each entered by a step: it looks clipped at its "
+            "range, and the spectrum, so every predicted drift, misses the rate beyond it")
 
 
 def _table(adv, ref) -> list[str]:
