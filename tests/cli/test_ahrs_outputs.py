@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import errno
 
+import pytest
+
 from strapdown._core.compile_notice import MESSAGE
 from strapdown.cli import main
 
@@ -177,3 +179,61 @@ def test_gyro_scale_sigma_reaches_the_filter_and_the_metadata(tmp_path, capsys):
         code = exc.code
     assert code == 2
     assert "--gyro-scale-sigma" in capsys.readouterr().err
+
+
+def test_gyro_range_reaches_the_filter_and_the_counts_the_metadata(tmp_path, capsys):
+    """``--gyro-range-deg-s``: a body spun about its z axis at 6 rad/s (344 °/s) after 2 s,
+    read by a gyro clipped at 5 rad/s. Given the range (5 rad/s = 286.5 °/s), it is the
+    config's, and every clipped sample's rate is taken from the field: the note and the
+    sidecar count them, and the yaw follows the spin within a degree (the clipped reading
+    alone falls 1 rad/s behind). Without the option the range is found from the record (a
+    flat top the field turns 1.2 times faster than), with the same counts. A range that is
+    not positive and finite is refused, naming it."""
+    import json
+    import math
+
+    import numpy as np
+
+    from strapdown.rotation.dcm import dcm_from_quat
+    from strapdown.rotation.quaternion import quat_from_rotvec
+
+    n, h, rate, clip = 3000, 0.01, 6.0, 5.0
+    t = np.arange(n) * h
+    spin = np.where(t < 2.0, 0.0, rate)
+    angle = np.concatenate([[0.0], np.cumsum(0.5 * h * (spin[1:] + spin[:-1]))])
+    c = dcm_from_quat(quat_from_rotvec(np.outer(angle, [0.0, 0.0, 1.0])))  # C_n_b
+    a = np.einsum("nji,j->ni", c, [0.0, 0.0, 9.81])
+    m = np.einsum("nji,j->ni", c, [0.0, 20.0, -40.0])
+    w = np.column_stack([np.zeros(n), np.zeros(n), np.minimum(spin, clip)])
+    rows = ["t,gx,gy,gz,ax,ay,az,mx,my,mz"]
+    rows += [",".join(repr(float(v)) for v in (t[i], *w[i], *a[i], *m[i])) for i in range(n)]
+    imu = tmp_path / "spin.csv"
+    imu.write_text("\n".join(rows) + "\n")
+    out = tmp_path / "att.csv"
+    assert main(["ahrs", "--imu", str(imu), "--gyro-units", "rad/s", "--acc-units", "m/s2",
+                 "--gyro-range-deg-s", str(math.degrees(clip)), "--out", str(out)]) == 0
+    cap = capsys.readouterr()
+    at_range = int((t >= 2.0).sum()) - 1  # the first spinning sample's rate is an interval's
+    assert f"at its range on {at_range + 1} samples" in cap.err
+    meta = json.loads(out.with_name(out.name + ".meta.json").read_text())
+    assert meta["gyro_at_range"]["samples"] == at_range + 1
+    assert meta["gyro_at_range"]["recovered_from_field"] >= at_range
+    assert meta["config"]["gyro_range"] == clip
+    q = np.loadtxt(out, delimiter=",", skiprows=1, usecols=(1, 2, 3, 4))
+    yaw = 2.0 * np.arctan2(q[:, 3], q[:, 0])
+    late = t > 10.0
+    err = np.degrees(np.abs(np.angle(np.exp(1j * (yaw[late] - angle[late])))))
+    assert err.max() < 1.0
+    found = tmp_path / "found.csv"
+    assert main(["ahrs", "--imu", str(imu), "--gyro-units", "rad/s", "--acc-units", "m/s2",
+                 "--out", str(found)]) == 0
+    capsys.readouterr()
+    meta_found = json.loads(found.with_name(found.name + ".meta.json").read_text())
+    assert meta_found["gyro_at_range"] == meta["gyro_at_range"]
+    assert meta_found["config"]["gyro_range"] == pytest.approx(clip, rel=1e-3)  # found
+    for bad in ("0", "-5", "inf"):
+        with pytest.raises(SystemExit) as exc:
+            main(["ahrs", "--imu", str(imu), "--gyro-units", "rad/s", "--acc-units", "m/s2",
+                  "--gyro-range-deg-s", bad, "--out", str(tmp_path / "x.csv")])
+        assert exc.value.code == 2
+        assert "--gyro-range-deg-s is the gyro's full scale" in capsys.readouterr().err

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 import time
 
 from strapdown.cli._common import (
@@ -99,6 +100,11 @@ def _arguments(p: argparse.ArgumentParser) -> None:
                    "relative scale-factor error, e.g. 0.01; the gyro bias then follows the "
                    "scale error of the sustained rotation (AhrsConfig.gyro_scale_sigma). "
                    "Default 0: off, right for a calibrated gyro")
+    p.add_argument("--gyro-range-deg-s", type=float, default=None, metavar="DEG_S",
+                   help="the gyro's full scale, °/s (a datasheet's ±2000 °/s: 2000): a rate "
+                   "at it is taken as clipped, and the rotation beyond it from the field's "
+                   "turn (AhrsConfig.gyro_range, gyro_declip). Default: found from the record "
+                   "(plateaus entered by a step, or a flat top the field turns faster than)")
     progress_args(p, "a line as the filter starts and ends")
 
 
@@ -115,9 +121,14 @@ def run(args: argparse.Namespace) -> int:
     if not (0.0 <= args.gyro_scale_sigma < 1.0):
         raise InputError(f"--gyro-scale-sigma is a relative scale-factor error's standard "
                          f"deviation, within [0, 1) (e.g. 0.01), got {args.gyro_scale_sigma:g}")
+    rng = args.gyro_range_deg_s
+    if rng is not None and not 0.0 < rng < math.inf:
+        raise InputError(f"--gyro-range-deg-s is the gyro's full scale in °/s, positive and "
+                         f"finite (e.g. 2000), got {rng:g}")
     cfg = AhrsConfig(gating=not args.no_gating, declination_deg=args.declination_deg,
                      gyro_sample=args.gyro_sample, acc_sample=args.acc_sample,
-                     mag_sample=args.mag_sample, gyro_scale_sigma=args.gyro_scale_sigma)
+                     mag_sample=args.mag_sample, gyro_scale_sigma=args.gyro_scale_sigma,
+                     gyro_range=0.0 if rng is None else math.radians(rng))
     show = progress(args)
     if show:
         say(f"filtering {args.imu} ({args.algorithm}"
