@@ -102,30 +102,37 @@ def _ratio(results: dict, name: str, ours: str, peer: str, key: str = "total_deg
     return results[(name, ours)][key] / results[(name, peer)][key]
 
 
+def _header() -> list[str]:
+    """The per-scenario tables' header: each filter with its kind, then the two ratios."""
+    return ["scenario"] + [f"{f} ({KIND[f]})" for f in FILTERS] + [
+        "ours/VQF causal", "ours/VQF offline"]
+
+
+def _mean_cell(errors: Sequence[dict]) -> str:
+    """``total / inclination`` (°), each the mean over ``errors`` (``broad_errors``
+    records); a dash for none."""
+    if not errors:
+        return "—"
+    return (f"{np.mean([e['total_deg'] for e in errors]):.2f} / "
+            f"{np.mean([e['inclination_deg'] for e in errors]):.2f}")
+
+
 def rows(results: dict, names: Sequence[str]) -> tuple[list[str], list[list[str]]]:
     """The per-scenario table: total / inclination RMSE (°) of each filter, and ours/VQF of
     the same kind (total), one row per scenario and a row of means."""
-    header = ["scenario"] + [f"{f} ({KIND[f]})" for f in FILTERS] + [
-        "ours/VQF causal", "ours/VQF offline"]
-
-    def cell(n: str, f: str) -> str:
-        e = results.get((n, f))
-        return "—" if e is None else f"{e['total_deg']:.2f} / {e['inclination_deg']:.2f}"
-
     out = []
     for n in names:
-        out.append([n] + [cell(n, f) for f in FILTERS]
+        out.append([n] + [_mean_cell([results[(n, f)]] if (n, f) in results else [])
+                          for f in FILTERS]
                    + [f"{_ratio(results, n, a, b):.2f}" for a, b in PAIRS])
-    means = {f: [results[(n, f)] for n in names if (n, f) in results] for f in FILTERS}
-    mean_cells = [f"{np.mean([e['total_deg'] for e in v]):.2f} / "
-                  f"{np.mean([e['inclination_deg'] for e in v]):.2f}" if v else "—"
-                  for v in means.values()]
+    mean_cells = [_mean_cell([results[(n, f)] for n in names if (n, f) in results])
+                  for f in FILTERS]
     mean_ratio = []
     for a, b in PAIRS:
         r = [_ratio(results, n, a, b) for n in names]
         mean_ratio.append(f"{np.exp(np.nanmean(np.log(r))):.2f} (geo.)" if r else "—")
     out.append(["**mean**", *mean_cells, *mean_ratio])
-    return header, out
+    return _header(), out
 
 
 def ratios(per_seed: Mapping[int, dict], name: str, ours: str, peer: str) -> list[float]:
@@ -152,17 +159,12 @@ def seeds_rows(per_seed: Mapping[int, dict], names: Sequence[str]
     """The per-scenario table over seeds (``per_seed``: :func:`evaluate`'s results by seed):
     each filter's mean total / inclination RMSE (°) over the seeds, and each ratio of ours
     over the VQF of the same kind as :func:`ratio_cell`."""
-    header = ["scenario"] + [f"{f} ({KIND[f]})" for f in FILTERS] + [
-        "ours/VQF causal", "ours/VQF offline"]
     out = []
     for n in names:
-        cells = [n]
-        for f in FILTERS:
-            e = [r[(n, f)] for r in per_seed.values() if (n, f) in r]
-            cells.append(f"{np.mean([x['total_deg'] for x in e]):.2f} / "
-                         f"{np.mean([x['inclination_deg'] for x in e]):.2f}" if e else "—")
+        cells = [n] + [_mean_cell([r[(n, f)] for r in per_seed.values() if (n, f) in r])
+                       for f in FILTERS]
         out.append(cells + [ratio_cell(ratios(per_seed, n, a, b)) for a, b in PAIRS])
-    return header, out
+    return _header(), out
 
 
 def summary_table(results: dict, names: Sequence[str]) -> str:
@@ -186,7 +188,6 @@ def generalisation(out: str | os.PathLike[str], *, seeds: Sequence[int] = range(
         raise ValueError(f"seeds must be distinct and at least one, got {seeds}")
     rep = Report.begin(out, progress)
     per_seed: dict[int, dict] = {}
-    scenarios = suite(seeds[0])
     for seed in seeds:
         scenarios = suite(seed)
         say = rep.say if len(seeds) == 1 else (lambda m, s=seed: rep.say(f"seed {s}: {m}"))
