@@ -107,10 +107,16 @@ def gyro_plateaus(omega: ArrayLike) -> list[Plateaus]:
     w = np.ascontiguousarray(omega, dtype=np.float64)
     if w.ndim != 2 or w.shape[1] != 3:
         raise ValueError(f"omega must have shape (n, 3), got {w.shape}")
+    return [p for p in _plateaus(w, STEP) if p.runs >= MIN_RUNS and p.level >= MIN_LEVEL]
+
+
+def _plateaus(w: np.ndarray, step: float) -> list[Plateaus]:
+    """Every axis's plateaus near its largest rate, entered by a step of at least ``step``
+    of the level (:func:`strapdown.ahrs._kernel.gyro_plateau_runs`; ``w`` contiguous,
+    float64, (n, 3)), as one :class:`Plateaus` per axis."""
     runs, samples, level = np.zeros(3, np.int64), np.zeros(3, np.int64), np.zeros(3)
-    K.gyro_plateau_runs(w, NEAR, FLAT, STEP, MIN_RUN, runs, samples, level)
-    return [Plateaus(a, int(runs[a]), float(level[a]), int(samples[a])) for a in range(3)
-            if runs[a] >= MIN_RUNS and level[a] >= MIN_LEVEL]
+    K.gyro_plateau_runs(w, NEAR, FLAT, step, MIN_RUN, runs, samples, level)
+    return [Plateaus(a, int(runs[a]), float(level[a]), int(samples[a])) for a in range(3)]
 
 
 def field_plateaus(omega: ArrayLike, mag: ArrayLike, h: float) -> list[Plateaus]:
@@ -131,19 +137,17 @@ def field_plateaus(omega: ArrayLike, mag: ArrayLike, h: float) -> list[Plateaus]
     if w.ndim != 2 or w.shape[1] != 3 or m.shape != w.shape:
         raise ValueError(f"omega and mag must have the same shape (n, 3), got {w.shape} and "
                          f"{m.shape}")
-    runs, samples, level = np.zeros(3, np.int64), np.zeros(3, np.int64), np.zeros(3)
-    K.gyro_plateau_runs(w, NEAR, FLAT, 0.0, MIN_RUN, runs, samples, level)
     found = []
-    for a in range(3):
-        if not (runs[a] >= 1 and level[a] >= MIN_LEVEL and samples[a] * h >= FIELD_MIN_S):
+    for p in _plateaus(w, 0.0):
+        if not (p.runs >= 1 and p.level >= MIN_LEVEL and p.samples * h >= FIELD_MIN_S):
             continue
-        g, done = declip(w, m, float(level[a]), h)
-        sel = done[:, a]
+        g, done = declip(w, m, p.level, h)
+        sel = done[:, p.axis]
         if sel.sum() * h < FIELD_MIN_S:
             continue
-        turn = float(np.sum(np.sign(w[sel, a]) * g[sel, a]))
-        if turn >= FIELD_RATIO * float(np.sum(np.abs(w[sel, a]))):
-            found.append(Plateaus(a, int(runs[a]), float(level[a]), int(samples[a])))
+        turn = float(np.sum(np.sign(w[sel, p.axis]) * g[sel, p.axis]))
+        if turn >= FIELD_RATIO * float(np.sum(np.abs(w[sel, p.axis]))):
+            found.append(p)
     return found
 
 
