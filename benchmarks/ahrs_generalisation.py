@@ -1,8 +1,8 @@
 """The AHRS generalisation suite over several seeds: our filter and VQF on simulated recordings.
 
 Usage: ``python benchmarks/ahrs_generalisation.py [--seeds 0 1 … 19] [--aligned]
-[--hard-iron F --soft-iron F] [--gyro-scale SD --gyro-misalignment SD] [--acc-sample interval]
-[--gyro-clip F] [--set FIELD=VALUE ...] [--out reports/ahrs_generalisation.json]``.
+[--hard-iron F --soft-iron F] [--gyro-scale SD --gyro-misalignment SD]
+[--acc-scale SD --acc-misalignment SD] [--acc-sample interval] [--gyro-clip F] [--set FIELD=VALUE ...] [--out reports/ahrs_generalisation.json]``.
 
 Each seed draws the sensor errors and the random parts of the motions
 (:func:`strapdown.truth.scenarios.suite`, :func:`~strapdown.truth.scenarios.record`); each
@@ -23,6 +23,9 @@ per seed and recording (docs/reproductions.md, "A magnetometer that is not calib
 and cross-axis errors of these standard deviations drawn per seed and recording
 (``Sensors.gyro_scale_sd``, ``gyro_misalignment_sd``; a consumer MEMS gyro untrimmed: about
 0.01 and 0.005; docs/reproductions.md, "A gyro that is not calibrated").
+``--acc-scale SD --acc-misalignment SD`` does the same to the accelerometer
+(``Sensors.acc_scale_sd``, ``acc_misalignment_sd``; a consumer MEMS accelerometer trimmed:
+about 0.005 and 0.005; docs/reproductions.md, "An accelerometer that is not calibrated").
 ``--gyro-clip F`` gives every filter a gyro clipped at ``F`` times each recording's largest
 |rate| (:func:`clipped_gyro`; a gyro past its range, docs/reproductions.md, "A gyro past its
 range": the 0.3 m pendulum at 0.6 and 0.8; the other scenarios' peaks lie below 2 rad/s, under
@@ -82,6 +85,11 @@ def main(argv: list[str] | None = None) -> int:
                     help="the gyro's scale-factor errors, standard deviation (e.g. 0.01)")
     ap.add_argument("--gyro-misalignment", type=float, default=0.0,
                     help="its cross-axis sensitivities, standard deviation (e.g. 0.005)")
+    ap.add_argument("--acc-scale", type=float, default=0.0,
+                    help="the accelerometer's scale-factor errors, standard deviation "
+                    "(e.g. 0.005)")
+    ap.add_argument("--acc-misalignment", type=float, default=0.0,
+                    help="its cross-axis sensitivities, standard deviation (e.g. 0.005)")
     ap.add_argument("--acc-sample", choices=["point", "interval"], default="point",
                     help="the simulated accelerometer's samples: at the stamps (the suite's) "
                     "or means over each period, like the gyro's")
@@ -105,7 +113,8 @@ def main(argv: list[str] | None = None) -> int:
         print(f"seed {seed}", file=sys.stderr)
         scenarios = [dataclasses.replace(sc, sensors=dataclasses.replace(
             sc.sensors, acc_sample=args.acc_sample, gyro_scale_sd=args.gyro_scale,
-            gyro_misalignment_sd=args.gyro_misalignment)) for sc in suite(seed)]
+            gyro_misalignment_sd=args.gyro_misalignment, acc_scale_sd=args.acc_scale,
+            acc_misalignment_sd=args.acc_misalignment)) for sc in suite(seed)]
         names = [s.name for s in scenarios]
         alter = None
         if args.hard_iron or args.soft_iron or args.gyro_clip:
@@ -137,6 +146,9 @@ def main(argv: list[str] | None = None) -> int:
     if args.gyro_scale or args.gyro_misalignment:
         print(f"gyro uncalibrated: scale factors ±{args.gyro_scale:g}, cross-axis "
               f"±{args.gyro_misalignment:g} (standard deviations)")
+    if args.acc_scale or args.acc_misalignment:
+        print(f"accelerometer uncalibrated: scale factors ±{args.acc_scale:g}, cross-axis "
+              f"±{args.acc_misalignment:g} (standard deviations)")
     if args.gyro_clip:
         print(f"gyro clipped at {args.gyro_clip:g} of each recording's peak rate")
     if args.config:

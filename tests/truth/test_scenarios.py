@@ -274,6 +274,40 @@ def test_gyro_scale_and_cross_axis_errors_multiply_the_true_rate_and_bias():
         S.Sensors(100.0, gyro_scale_sd=-0.01)
 
 
+def test_accelerometer_scale_and_cross_axis_errors_multiply_the_true_force_and_bias():
+    """With ``acc_scale_sd`` and ``acc_misalignment_sd`` the accelerometer reads
+    ``M_a (f + b_a) + n``: every other draw as without them (``M_a`` is drawn after the
+    gyro's), the difference exactly ``(M_a − I)(f + b_a)`` with the recorded bias, ``M_a``'s
+    diagonal and off-diagonal of the stated sizes over many seeds; without them the
+    identity."""
+    sc = SUITE["rests"]
+    bad = dataclasses.replace(sc, sensors=dataclasses.replace(
+        sc.sensors, acc_scale_sd=0.01, acc_misalignment_sd=0.005, gyro_scale_sd=0.01))
+    gyro_only = dataclasses.replace(sc, sensors=dataclasses.replace(
+        sc.sensors, gyro_scale_sd=0.01))
+    dur = 16.0  # a rest, a turn and the next rest
+    ideal = S.record(sc, noise=False, duration_s=dur)
+    plain = S.record(gyro_only, 5, duration_s=dur)
+    rec = S.record(bad, 5, duration_s=dur)
+    np.testing.assert_array_equal(plain.acc_matrix, np.eye(3))
+    for x in ("gyro", "mag", "gyro_bias", "gyro_matrix", "acc_bias", "q_n_b"):
+        np.testing.assert_array_equal(getattr(rec, x), getattr(plain, x))
+    np.testing.assert_allclose(np.linalg.norm(plain.acc_bias), np.linalg.norm(
+        (plain.acc - ideal.acc).mean(0)), rtol=0.05)  # the recorded bias is the one applied
+    err = rec.acc_matrix - np.eye(3)
+    np.testing.assert_allclose(rec.acc - plain.acc, (ideal.acc + plain.acc_bias) @ err.T,
+                               rtol=0, atol=1e-12)
+    assert np.abs(rec.acc - plain.acc).max() > 0.02  # gravity reads visibly off
+    assert not np.any(S.record(sc, noise=False, duration_s=0.05).acc_bias)
+    mats = np.array([S.record(bad, s, duration_s=0.05).acc_matrix - np.eye(3)
+                     for s in range(200)])
+    off = ~np.eye(3, dtype=bool)
+    assert 0.0085 < mats[:, ~off].std() < 0.0115
+    assert 0.0043 < mats[:, off].std() < 0.0057
+    with pytest.raises(ValueError, match="acc_misalignment_sd"):
+        S.Sensors(100.0, acc_misalignment_sd=-0.01)
+
+
 def test_record_refuses_a_duration_beyond_the_scenario():
     with pytest.raises(ValueError, match="exceeds"):
         S.record(SUITE["rests"], duration_s=1000.0)

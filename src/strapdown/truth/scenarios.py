@@ -235,6 +235,12 @@ class Sensors:
         order). Default 0 (the suite's recordings); a consumer MEMS gyro's data sheet gives
         ±1–3 % and ±1–2 % untrimmed (a standard deviation of about 0.01 and 0.005). Drawn
         after every other error, so a recording with and without them shares its noise.
+    acc_scale_sd, acc_misalignment_sd : float
+        The same for the accelerometer: the measured specific force is ``M_a (f + b_a) + n``
+        with ``M_a − I`` drawn so. Default 0 (the suite's recordings); a consumer MEMS
+        accelerometer's data sheet gives a sensitivity tolerance of ±1–3 % and a cross-axis
+        sensitivity of ±1–2 % (trimmed, about 0.005 and 0.005). Drawn after the gyro's, so
+        a recording with and without them shares every other draw.
     acc_sample : {"point", "interval"}
         What an accelerometer sample is: the specific force at the stamp (``point``,
         default: the suite's recordings) or its mean over the sample period that ends at
@@ -254,6 +260,8 @@ class Sensors:
     mag_unit: float = 1.0
     gyro_scale_sd: float = 0.0
     gyro_misalignment_sd: float = 0.0
+    acc_scale_sd: float = 0.0
+    acc_misalignment_sd: float = 0.0
     acc_sample: Literal["point", "interval"] = "point"
 
     def __post_init__(self):
@@ -263,7 +271,8 @@ class Sensors:
         positive(self.mag_unit, "mag_unit")
         positive(self.gyro_bias_gm_tau, "gyro_bias_gm_tau")
         for name in ("gyro_noise", "gyro_bias_sd", "gyro_bias_gm_sigma", "acc_noise",
-                     "acc_bias_sd", "mag_noise", "gyro_scale_sd", "gyro_misalignment_sd"):
+                     "acc_bias_sd", "mag_noise", "gyro_scale_sd", "gyro_misalignment_sd",
+                     "acc_scale_sd", "acc_misalignment_sd"):
             if not float(getattr(self, name)) >= 0:
                 raise ValueError(f"{name} must be non-negative, got {getattr(self, name)!r}")
 
@@ -324,6 +333,12 @@ class SimulatedRecording:
     gyro_matrix : ndarray (3, 3)
         The gyro's scale-factor and cross-axis matrix ``M`` (``Sensors.gyro_scale_sd``,
         ``gyro_misalignment_sd``); the identity when they are zero or ``noise=False``.
+    acc_bias : ndarray (3,)
+        The accelerometer's constant bias ``b_a``, m/s²; zero when ``noise=False``.
+    acc_matrix : ndarray (3, 3)
+        The accelerometer's scale-factor and cross-axis matrix ``M_a``
+        (``Sensors.acc_scale_sd``, ``acc_misalignment_sd``); the identity when they are zero
+        or ``noise=False``.
     """
 
     scenario: Scenario
@@ -335,6 +350,8 @@ class SimulatedRecording:
     mag: NDArray[np.float64]
     gyro_bias: NDArray[np.float64]
     gyro_matrix: NDArray[np.float64] = field(default_factory=lambda: np.eye(3))
+    acc_bias: NDArray[np.float64] = field(default_factory=lambda: np.zeros(3))
+    acc_matrix: NDArray[np.float64] = field(default_factory=lambda: np.eye(3))
 
     @property
     def name(self) -> str:
@@ -361,6 +378,8 @@ def record(scenario: Scenario, seed: RngLike = 0, *, noise: bool = True,
     m_b = body.field_b(t)
     bias = np.zeros((n, 3))
     mat = np.eye(3)
+    acc_b = np.zeros(3)
+    acc_mat = np.eye(3)
     if noise:
         rng = np.random.default_rng(seed)
         b0 = s.gyro_bias_sd * rng.standard_normal(3)
@@ -369,8 +388,9 @@ def record(scenario: Scenario, seed: RngLike = 0, *, noise: bool = True,
         bias = b0 + slow.apply(np.zeros((n, 3)), "rate", h, rng)
         w_b = w + bias
         w = GyroErrors(white_noise=s.gyro_noise).apply(w_b, "rate", h, rng)
-        acc_err = AccelerometerErrors(white_noise=s.acc_noise,
-                                      bias=s.acc_bias_sd * rng.standard_normal(3))
+        acc_b = s.acc_bias_sd * rng.standard_normal(3)
+        acc_err = AccelerometerErrors(white_noise=s.acc_noise, bias=acc_b)
+        f_true = f
         f = accelerometer(t, q, f, h, errors=acc_err, rng=rng)
         c_b_n = np.swapaxes(dcm_from_quat(q), -1, -2)
         m_b = MagnetometerErrors(white_noise=s.mag_noise).apply(t, m_b, c_b_n, rng)
@@ -379,7 +399,13 @@ def record(scenario: Scenario, seed: RngLike = 0, *, noise: bool = True,
             np.fill_diagonal(err, s.gyro_scale_sd * rng.standard_normal(3))
             w = w + w_b @ err.T
             mat = mat + err
-    return SimulatedRecording(scenario, t, h, q, w, f, m_b * s.mag_unit, bias, mat)
+        if s.acc_scale_sd > 0 or s.acc_misalignment_sd > 0:  # M_a (f + b_a) + n, drawn last
+            err = s.acc_misalignment_sd * rng.standard_normal((3, 3))
+            np.fill_diagonal(err, s.acc_scale_sd * rng.standard_normal(3))
+            f = f + (f_true + acc_b) @ err.T
+            acc_mat = acc_mat + err
+    return SimulatedRecording(scenario, t, h, q, w, f, m_b * s.mag_unit, bias, mat, acc_b,
+                              acc_mat)
 
 
 # ------------------------------------------------------------------------------ pendulum
