@@ -2,7 +2,8 @@
 
 Usage: ``python benchmarks/ahrs_generalisation.py [--seeds 0 1 … 19] [--aligned]
 [--hard-iron F --soft-iron F] [--gyro-scale SD --gyro-misalignment SD]
-[--acc-scale SD --acc-misalignment SD] [--acc-sample interval] [--gyro-clip F] [--set FIELD=VALUE ...] [--out reports/ahrs_generalisation.json]``.
+[--acc-scale SD --acc-misalignment SD] [--acc-sample interval] [--gyro-clip F]
+[--set FIELD=VALUE ...] [--out reports/ahrs_generalisation.json]``.
 
 Each seed draws the sensor errors and the random parts of the motions
 (:func:`strapdown.truth.scenarios.suite`, :func:`~strapdown.truth.scenarios.record`); each
