@@ -54,3 +54,23 @@ def test_the_magnetometer_unit_does_not_change_the_attitude(recording, run):
         assert err < ROUNDING_DEG, scale
         assert np.array_equal(r.flags, base.flags), scale
         assert np.array_equal(r.mag_delay_s, base.mag_delay_s), scale
+
+
+@pytest.mark.filterwarnings("ignore::strapdown.ahrs.saturation.GyroSaturationWarning")
+@pytest.mark.parametrize("run", [ekf, offline_ekf], ids=["ekf", "offline_ekf"])
+def test_the_rate_beyond_a_gyro_s_range_does_not_depend_on_the_unit(run):
+    """Where the gyro clips, the rate beyond its range is taken from the field's turn
+    (``AhrsConfig.gyro_declip``): a direction's turn, the same in any unit. The suite's 0.3 m
+    pendulum read by a gyro clipped at 60 % of its peak (its first 20 s): the same attitudes
+    and the same samples recovered with the field in µT, gauss and × 1000."""
+    from suite_records import clipped_pendulum
+
+    t, gyro, acc, mag, _q, _level = clipped_pendulum(duration_s=20.0)
+    base = run(t, gyro, acc, mag)
+    assert base.gyro_recovered > 100  # the field is at work
+    for scale in (0.01, 1000.0):
+        r = run(t, gyro, acc, mag * scale)
+        err = np.degrees(attitude_error_angle(r.q, base.q)).max()
+        assert err < ROUNDING_DEG, scale
+        assert r.gyro_recovered == base.gyro_recovered, scale
+        assert np.array_equal(r.flags, base.flags), scale
