@@ -246,6 +246,16 @@ def test_sensor_errors_have_the_stated_size():
     np.testing.assert_allclose(m_err.std(0), s.mag_noise, rtol=0.05)
 
 
+def _assert_drawn_sizes(scenario, attr: str, scale: float, cross: float):
+    """Over 200 seeds the drawn matrix's diagonal less one and its off-diagonal entries have
+    standard deviations ``scale`` and ``cross`` (within 15 %)."""
+    mats = np.array([getattr(S.record(scenario, s, duration_s=0.05), attr) - np.eye(3)
+                     for s in range(200)])
+    off = ~np.eye(3, dtype=bool)
+    assert 0.85 * scale < mats[:, ~off].std() < 1.15 * scale
+    assert 0.85 * cross < mats[:, off].std() < 1.15 * cross
+
+
 def test_gyro_scale_and_cross_axis_errors_multiply_the_true_rate_and_bias():
     """With ``gyro_scale_sd`` and ``gyro_misalignment_sd`` the gyro reads ``M (ω + b) + n``:
     the same noise, bias, accelerometer and field as without them (M is drawn last), the
@@ -265,11 +275,7 @@ def test_gyro_scale_and_cross_axis_errors_multiply_the_true_rate_and_bias():
     np.testing.assert_allclose(rec.gyro - plain.gyro, (ideal.gyro + plain.gyro_bias) @ err.T,
                                rtol=0, atol=1e-12)
     assert np.abs(rec.gyro - plain.gyro).max() > 1e-3  # the spin reads visibly off
-    mats = np.array([S.record(bad, s, duration_s=0.05).gyro_matrix - np.eye(3)
-                     for s in range(200)])
-    off = ~np.eye(3, dtype=bool)
-    assert 0.0085 < mats[:, ~off].std() < 0.0115
-    assert 0.0043 < mats[:, off].std() < 0.0057
+    _assert_drawn_sizes(bad, "gyro_matrix", scale=0.01, cross=0.005)
     with pytest.raises(ValueError, match="gyro_scale_sd"):
         S.Sensors(100.0, gyro_scale_sd=-0.01)
 
@@ -299,11 +305,7 @@ def test_accelerometer_scale_and_cross_axis_errors_multiply_the_true_force_and_b
                                rtol=0, atol=1e-12)
     assert np.abs(rec.acc - plain.acc).max() > 0.02  # gravity reads visibly off
     assert not np.any(S.record(sc, noise=False, duration_s=0.05).acc_bias)
-    mats = np.array([S.record(bad, s, duration_s=0.05).acc_matrix - np.eye(3)
-                     for s in range(200)])
-    off = ~np.eye(3, dtype=bool)
-    assert 0.0085 < mats[:, ~off].std() < 0.0115
-    assert 0.0043 < mats[:, off].std() < 0.0057
+    _assert_drawn_sizes(bad, "acc_matrix", scale=0.01, cross=0.005)
     with pytest.raises(ValueError, match="acc_misalignment_sd"):
         S.Sensors(100.0, acc_misalignment_sd=-0.01)
 
