@@ -304,7 +304,9 @@ def test_accelerometer_scale_and_cross_axis_errors_multiply_the_true_force_and_b
     np.testing.assert_allclose(rec.acc - plain.acc, (ideal.acc + plain.acc_bias) @ err.T,
                                rtol=0, atol=1e-12)
     assert np.abs(rec.acc - plain.acc).max() > 0.02  # gravity reads visibly off
-    assert not np.any(S.record(sc, noise=False, duration_s=0.05).acc_bias)
+    ideal_bad = S.record(bad, noise=False, duration_s=0.05)
+    assert not np.any(ideal_bad.acc_bias)
+    np.testing.assert_array_equal(ideal_bad.acc_matrix, np.eye(3))
     _assert_drawn_sizes(bad, "acc_matrix", scale=0.01, cross=0.005)
     with pytest.raises(ValueError, match="acc_misalignment_sd"):
         S.Sensors(100.0, acc_misalignment_sd=-0.01)

@@ -234,7 +234,8 @@ class Sensors:
         the measured rate is ``M (ω + b) + n`` (:class:`~strapdown.truth.sensors.GyroErrors`'s
         order). Default 0 (the suite's recordings); a consumer MEMS gyro's data sheet gives
         ±1–3 % and ±1–2 % untrimmed (a standard deviation of about 0.01 and 0.005). Drawn
-        after every other error, so a recording with and without them shares its noise.
+        after every other error but the accelerometer's matrix, so a recording with and
+        without them shares its noise.
     acc_scale_sd, acc_misalignment_sd : float
         The same for the accelerometer: the measured specific force is ``M_a (f + b_a) + n``
         with ``M_a − I`` drawn so. Default 0 (the suite's recordings); a consumer MEMS
