@@ -246,7 +246,8 @@ def declip(omega: ArrayLike, mag: ArrayLike, level: float, h: float) -> tuple[np
         return w, out
     nr = near[rows]
     mb = 0.5 * (m[rows] + m[rows - 1])
-    r = -(m[rows] - m[rows - 1]) / h - np.cross(np.where(nr, 0.0, w[rows]), mb)
+    c = np.where(nr, 0.0, w[rows])  # the unclipped axes' readings; then the Cayley vector
+    r = -(m[rows] - m[rows - 1]) / h - np.cross(c, mb)
     mm = np.einsum("ij,ij->i", mb, mb)
     two = nr.sum(axis=1) == 2
     # the clipped axes a (and b): the first (and last) clipped one
@@ -264,7 +265,6 @@ def declip(omega: ArrayLike, mag: ArrayLike, level: float, h: float) -> tuple[np
     d = np.where(ok, det, 1.0)
     u_a = np.where(two, (g_bb * r_a - g_ab * r_b) / d, r_a / d)
     u_b = np.where(two, (g_aa * r_b - g_ab * r_a) / d, 0.0)
-    c = np.where(nr, 0.0, w[rows])
     idx = np.arange(rows.size)
     c[idx, a] = u_a
     c[idx[two], b[two]] = u_b[two]

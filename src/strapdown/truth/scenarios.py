@@ -359,6 +359,16 @@ class SimulatedRecording:
         return self.scenario.name
 
 
+def _error_matrix(scale_sd: float, misalignment_sd: float, rng: np.random.Generator
+                  ) -> NDArray[np.float64]:
+    """A sensor's ``M − I``: cross-axis sensitivities of standard deviation
+    ``misalignment_sd`` off the diagonal, scale-factor errors of ``scale_sd`` on it (drawn
+    in that order from ``rng``)."""
+    err = misalignment_sd * rng.standard_normal((3, 3))
+    np.fill_diagonal(err, scale_sd * rng.standard_normal(3))
+    return err
+
+
 def record(scenario: Scenario, seed: RngLike = 0, *, noise: bool = True,
            duration_s: float | None = None) -> SimulatedRecording:
     """Sample ``scenario`` at its rate from ``t = 0`` for ``duration_s`` (default: the
@@ -396,13 +406,11 @@ def record(scenario: Scenario, seed: RngLike = 0, *, noise: bool = True,
         c_b_n = np.swapaxes(dcm_from_quat(q), -1, -2)
         m_b = MagnetometerErrors(white_noise=s.mag_noise).apply(t, m_b, c_b_n, rng)
         if s.gyro_scale_sd > 0 or s.gyro_misalignment_sd > 0:  # M (ω + b) + n, M drawn last
-            err = s.gyro_misalignment_sd * rng.standard_normal((3, 3))
-            np.fill_diagonal(err, s.gyro_scale_sd * rng.standard_normal(3))
+            err = _error_matrix(s.gyro_scale_sd, s.gyro_misalignment_sd, rng)
             w = w + w_b @ err.T
             mat = mat + err
-        if s.acc_scale_sd > 0 or s.acc_misalignment_sd > 0:  # M_a (f + b_a) + n, drawn last
-            err = s.acc_misalignment_sd * rng.standard_normal((3, 3))
-            np.fill_diagonal(err, s.acc_scale_sd * rng.standard_normal(3))
+        if s.acc_scale_sd > 0 or s.acc_misalignment_sd > 0:  # M_a (f + b_a) + n, after M
+            err = _error_matrix(s.acc_scale_sd, s.acc_misalignment_sd, rng)
             f = f + (f_true + acc_b) @ err.T
             acc_mat = acc_mat + err
     return SimulatedRecording(scenario, t, h, q, w, f, m_b * s.mag_unit, bias, mat, acc_b,
